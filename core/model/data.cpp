@@ -1,0 +1,54 @@
+#include "core/model/data.hpp"
+
+#include "core/model/rotation.hpp"
+
+namespace beamrail {
+
+Data::Data(const Model& model)
+    : pose(model.bodies.size()),
+      q(model.bodies.size()),
+      w(model.bodies.size()),
+      wrench(model.bodies.size(), Vec6::Zero()),
+      rail_floored(model.rails.size(), 0),
+      stiffness(model.pattern.blocks.size(), Mat6::Zero()),
+      damping(model.pattern.blocks.size(), Mat6::Zero()) {
+  for (size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    q[i] = b.orientation / b.orientation.norm();
+    w[i] = b.fixed ? Vec3::Zero() : b.angular_velocity;
+    pose[i].c = b.position;
+    pose[i].A = rotation_matrix<double>(q[i]);
+    pose[i].v = b.fixed ? Vec3::Zero() : b.velocity;
+    pose[i].omega = pose[i].A * w[i];
+  }
+}
+
+void set_state(const Model& model, Data& data, const double* y) {
+  for (int k = 0; k < model.n_free(); ++k) {
+    const int i = model.free_bodies[k];
+    const double* s = y + kStatesPerBody * k;
+    Pose<double>& p = data.pose[i];
+    p.c = Vec3(s[0], s[1], s[2]);
+    data.q[i] = Vec4(s[3], s[4], s[5], s[6]);
+    p.A = rotation_matrix<double>(data.q[i]);
+    p.v = Vec3(s[7], s[8], s[9]);
+    data.w[i] = Vec3(s[10], s[11], s[12]);
+    p.omega = p.A * data.w[i];
+  }
+}
+
+void initial_state(const Model& model, double* y) {
+  for (int k = 0; k < model.n_free(); ++k) {
+    const Body& b = model.bodies[model.free_bodies[k]];
+    double* s = y + kStatesPerBody * k;
+    const Vec4 q = b.orientation / b.orientation.norm();
+    for (int j = 0; j < 3; ++j) {
+      s[j] = b.position(j);
+      s[7 + j] = b.velocity(j);
+      s[10 + j] = b.angular_velocity(j);
+    }
+    for (int j = 0; j < 4; ++j) s[3 + j] = q(j);
+  }
+}
+
+}  // namespace beamrail

@@ -1,0 +1,37 @@
+// Data: everything mutable for one evaluation of a Model. One Data per thread; nothing in it is
+// shared, and nothing is allocated after construction on the evaluation path.
+#pragma once
+
+#include <vector>
+
+#include "core/model/element_kinematics.hpp"
+#include "core/model/model.hpp"
+
+namespace beamrail {
+
+struct Data {
+  explicit Data(const Model& model);
+
+  std::vector<Pose<double>> pose;  // per body (fixed bodies hold their initial pose)
+  std::vector<Vec4> q;             // Euler parameters per body
+  std::vector<Vec3> w;             // angular velocity in body axes per body [rad/s]
+
+  std::vector<Vec6> wrench;        // per body: force and moment about the centre, global [N, N m]
+  double elastic_energy = 0.0;     // sum of element strain energies [J]
+  std::vector<char> rail_floored;  // per rail: |l| was at min_length in the last evaluation
+
+  // Tangent blocks, one per model.pattern block (row body, column body):
+  std::vector<Mat6> stiffness;  // d wrench_row / d (dc, dtheta)_col  [N/m, N, N m]
+  std::vector<Mat6> damping;    // d wrench_row / d (v, omega)_col    [N s/m, N m s]
+
+  long n_wrench_evaluations = 0;
+  long n_tangent_evaluations = 0;
+};
+
+// Sets pose, q and w of the free bodies from a state vector y (dim model.n_states).
+void set_state(const Model& model, Data& data, const double* y);
+
+// Writes the initial state of the free bodies into y (dim model.n_states).
+void initial_state(const Model& model, double* y);
+
+}  // namespace beamrail

@@ -1,0 +1,102 @@
+// Kinematics shared by beams and rails (DESIGN.md §1, paper steps 1-4): the element frame carried
+// by each end, the deformation measured in the left-end frame, its rate, and the map from a
+// deformation gradient to the wrenches on the two bodies.
+//
+// Deformation coordinates: xi = E1^T (p2 - p1) (position of point 2 in the left-end frame) and
+// phi = (atan2(a32, a22), atan2(a13, a33), atan2(a21, a11)) of A = E1^T E2. A global rotation
+// increment theta_i of body i and a displacement dc_i of its centre change them by
+//   d xi  = E1^T (dc2 - dc1 - R2 x theta2 + (p2 - c1) x theta1)
+//   d phi = T E1^T (theta2 - theta1),
+// where T (3 x 3) is the derivative of the three angles with respect to a small rotation of the
+// right end expressed in the left-end frame. A force law given as a gradient g = dU/d(xi, phi) thus
+// yields the generalized forces -dU/d(c, theta) of both bodies (apply_deformation_gradient).
+#pragma once
+
+#include <cmath>
+
+#include "core/model/model.hpp"
+#include "core/model/rotation.hpp"
+
+namespace beamrail {
+
+// Position, orientation and velocity of a body, all in global axes.
+template <class T>
+struct Pose {
+  Vec3T<T> c;      // centre of mass [m]
+  Mat3T<T> A;      // body -> global rotation
+  Vec3T<T> v;      // velocity of the centre [m/s]
+  Vec3T<T> omega;  // angular velocity, global axes [rad/s]
+};
+
+template <class T>
+struct ElementFrames {
+  Mat3T<T> E1;      // element frame carried by the left end (global)
+  Vec3T<T> R1, R2;  // centre -> attachment point, global [m]
+  Vec3T<T> lever1;  // p2 - c1 [m]
+  Vec3T<T> xi;      // E1^T (p2 - p1) [m]
+  Mat3T<T> a;       // relative rotation E1^T E2
+  Vec3T<T> phi;     // rotation angles of the right end in the left-end frame [rad]
+  Mat3T<T> t;       // d phi / d (small rotation of the right end in the left-end frame)
+};
+
+template <class T>
+ElementFrames<T> element_frames(const ElementEnds& ends, const Pose<T>& b1, const Pose<T>& b2) {
+  using std::atan2;
+  ElementFrames<T> f;
+  f.E1 = b1.A * ends.frame1.cast<T>();
+  const Mat3T<T> e2 = b2.A * ends.frame2.cast<T>();
+  f.R1 = b1.A * ends.r1.cast<T>();
+  f.R2 = b2.A * ends.r2.cast<T>();
+  const Vec3T<T> p2 = b2.c + f.R2;
+  f.lever1 = p2 - b1.c;
+  f.xi = f.E1.transpose() * (f.lever1 - f.R1);
+  f.a = f.E1.transpose() * e2;
+  const Mat3T<T>& a = f.a;
+  f.phi << atan2(a(2, 1), a(1, 1)), atan2(a(0, 2), a(2, 2)), atan2(a(1, 0), a(0, 0));
+  const T nx = a(1, 1) * a(1, 1) + a(2, 1) * a(2, 1);
+  const T ny = a(0, 2) * a(0, 2) + a(2, 2) * a(2, 2);
+  const T nz = a(0, 0) * a(0, 0) + a(1, 0) * a(1, 0);
+  f.t << T(1), -a(0, 1) * a(1, 1) / nx, -a(0, 1) * a(2, 1) / nx,  //
+      -a(0, 2) * a(1, 2) / ny, T(1), -a(1, 2) * a(2, 2) / ny,     //
+      -a(0, 0) * a(2, 0) / nz, -a(1, 0) * a(2, 0) / nz, T(1);
+  return f;
+}
+
+// Rate of the deformation coordinates (d xi/dt, d phi/dt).
+template <class T>
+Vec6T<T> deformation_rate(const ElementFrames<T>& f, const Pose<T>& b1, const Pose<T>& b2) {
+  Vec6T<T> rate;
+  rate.template head<3>() =
+      f.E1.transpose() * (b2.v - b1.v - f.R2.cross(b2.omega) + f.lever1.cross(b1.omega));
+  rate.template tail<3>() = f.t * (f.E1.transpose() * (b2.omega - b1.omega));
+  return rate;
+}
+
+// Adds the generalized forces -dU/d(c, theta) of a gradient g = dU/d(xi, phi) to the wrenches
+// (force, moment about the centre of mass; global axes) on body 1 and body 2.
+template <class T>
+void apply_deformation_gradient(const ElementFrames<T>& f, const Vec6T<T>& g, Vec6T<T>& w1,
+                                Vec6T<T>& w2) {
+  const Vec3T<T> force = f.E1 * g.template head<3>();
+  const Vec3T<T> moment = f.E1 * (f.t.transpose() * g.template tail<3>());
+  w1.template head<3>() += force;
+  w1.template tail<3>() += f.lever1.cross(force) + moment;
+  w2.template head<3>() -= force;
+  w2.template tail<3>() -= f.R2.cross(force) + moment;
+}
+
+// Adds the paper's end wrenches (steps 11-14): P1, P2 are the local end vectors K1 delta and
+// K2 delta; body 1 gets force F2 and moment R1 x F2 - M1, body 2 gets -F2 and -(R2 x F2) - M2.
+template <class T>
+void apply_paper_end_wrenches(const ElementFrames<T>& f, const Vec6T<T>& p1, const Vec6T<T>& p2,
+                              Vec6T<T>& w1, Vec6T<T>& w2) {
+  const Vec3T<T> force = f.E1 * p2.template head<3>();
+  const Vec3T<T> m1 = f.E1 * p1.template tail<3>();
+  const Vec3T<T> m2 = f.E1 * p2.template tail<3>();
+  w1.template head<3>() += force;
+  w1.template tail<3>() += f.R1.cross(force) - m1;
+  w2.template head<3>() -= force;
+  w2.template tail<3>() -= f.R2.cross(force) + m2;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,129 @@
+#include "core/model/forces.hpp"
+
+#include "core/model/beam.hpp"
+#include "core/model/element_tangent.hpp"
+#include "core/model/rail.hpp"
+
+namespace beamrail {
+namespace {
+
+void add_loads(const Model& model, Data& data, double t) {
+  for (const Body& b : model.bodies) {
+    if (b.fixed) continue;
+    const int i = static_cast<int>(&b - model.bodies.data());
+    data.wrench[i].head<3>() += b.mass * model.gravity;
+  }
+  for (const Load& load : model.loads) {
+    const Vec3 value = load.time(t) * load.value;
+    Vec6& w = data.wrench[load.body];
+    if (load.kind == LoadKind::kForce) {
+      const Vec3 lever = data.pose[load.body].A * load.offset;
+      w.head<3>() += value;
+      w.tail<3>() += lever.cross(value);
+    } else {
+      w.tail<3>() += value;
+    }
+  }
+}
+
+// Scatters an element's 12 x 12 derivative into the four pattern blocks of its ends.
+void scatter(const std::array<int, 4>& blocks, const Mat12& j, std::vector<Mat6>& out) {
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b) {
+      const int k = blocks[2 * a + b];
+      if (k >= 0) out[k] += j.block<6, 6>(6 * a, 6 * b);
+    }
+}
+
+}  // namespace
+
+void compute_wrenches(const Model& model, Data& data, double t) {
+  for (Vec6& w : data.wrench) w.setZero();
+  add_loads(model, data, t);
+  double energy = 0.0;
+  for (const Beam& e : model.beams) {
+    const int i1 = e.ends.body1, i2 = e.ends.body2;
+    energy += beam_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2]);
+  }
+  for (size_t r = 0; r < model.rails.size(); ++r) {
+    const Rail& e = model.rails[r];
+    const int i1 = e.ends.body1, i2 = e.ends.body2;
+    bool floored = false;
+    energy += rail_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2],
+                            &floored);
+    data.rail_floored[r] = floored;
+  }
+  data.elastic_energy = energy;
+  ++data.n_wrench_evaluations;
+}
+
+void compute_tangent(const Model& model, Data& data, double t, bool with_velocity) {
+  for (Mat6& k : data.stiffness) k.setZero();
+  if (with_velocity)
+    for (Mat6& c : data.damping) c.setZero();
+
+  // Loads at body points: the moment lever turns with the body, d(R x F)/dtheta = [F]x [R]x.
+  for (const Load& load : model.loads) {
+    const int k = model.bodies[load.body].free_index;
+    if (k < 0 || load.kind != LoadKind::kForce) continue;
+    const Vec3 value = load.time(t) * load.value;
+    const Vec3 lever = data.pose[load.body].A * load.offset;
+    data.stiffness[k].block<3, 3>(3, 3) += skew<double>(value) * skew<double>(lever);
+  }
+
+  for (size_t n = 0; n < model.beams.size(); ++n) {
+    const Beam& e = model.beams[n];
+    const auto kernel = [&e](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
+                             Vec6T<Ad12>& w2) { beam_wrenches(e, b1, b2, w1, w2); };
+    const Pose<double>& p1 = data.pose[e.ends.body1];
+    const Pose<double>& p2 = data.pose[e.ends.body2];
+    const auto& blocks = model.pattern.beam_blocks[n];
+    scatter(blocks, element_jacobian(seed_configuration(p1, 0), seed_configuration(p2, 6), kernel),
+            data.stiffness);
+    if (with_velocity && e.damping > 0.0)
+      scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
+              data.damping);
+  }
+  for (size_t n = 0; n < model.rails.size(); ++n) {
+    const Rail& e = model.rails[n];
+    const auto kernel = [&e](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
+                             Vec6T<Ad12>& w2) {
+      bool floored = false;
+      rail_wrenches(e, b1, b2, w1, w2, &floored);
+    };
+    const Pose<double>& p1 = data.pose[e.ends.body1];
+    const Pose<double>& p2 = data.pose[e.ends.body2];
+    const auto& blocks = model.pattern.rail_blocks[n];
+    scatter(blocks, element_jacobian(seed_configuration(p1, 0), seed_configuration(p2, 6), kernel),
+            data.stiffness);
+    if (with_velocity && e.damping > 0.0)
+      scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
+              data.damping);
+  }
+  ++data.n_tangent_evaluations;
+}
+
+double kinetic_energy(const Model& model, const Data& data) {
+  double e = 0.0;
+  for (int i : model.free_bodies) {
+    const Body& b = model.bodies[i];
+    e += 0.5 * b.mass * data.pose[i].v.squaredNorm() + 0.5 * data.w[i].dot(b.inertia * data.w[i]);
+  }
+  return e;
+}
+
+double gravity_energy(const Model& model, const Data& data) {
+  double e = 0.0;
+  for (int i : model.free_bodies) e -= model.bodies[i].mass * model.gravity.dot(data.pose[i].c);
+  return e;
+}
+
+bool has_damping(const Model& model) {
+  for (const Beam& e : model.beams)
+    if (e.damping > 0.0) return true;
+  for (const Rail& e : model.rails)
+    if (e.damping > 0.0) return true;
+  return false;
+}
+
+}  // namespace beamrail

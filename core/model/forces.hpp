@@ -1,0 +1,27 @@
+// Assembly of the generalized forces on all bodies and of their exact tangent (stiffness and
+// damping blocks) from the element kernels, the loads and gravity.
+#pragma once
+
+#include "core/model/data.hpp"
+#include "core/model/model.hpp"
+
+namespace beamrail {
+
+// Sets data.wrench (every body; global force and moment about the centre of mass), data.elastic_energy
+// and data.rail_floored at time t [s] from data.pose.
+void compute_wrenches(const Model& model, Data& data, double t);
+
+// Sets data.stiffness (and data.damping when with_velocity) for every block of model.pattern at
+// time t from data.pose; the velocity blocks are exact for any scene, zero without damping.
+void compute_tangent(const Model& model, Data& data, double t, bool with_velocity);
+
+// Kinetic energy of all free bodies [J].
+double kinetic_energy(const Model& model, const Data& data);
+
+// Potential energy of gravity, -sum m g . c over free bodies [J].
+double gravity_energy(const Model& model, const Data& data);
+
+// True when any element has damping.
+bool has_damping(const Model& model);
+
+}  // namespace beamrail

@@ -1,0 +1,48 @@
+#include "core/model/model.hpp"
+
+#include <map>
+#include <utility>
+
+namespace beamrail {
+namespace {
+
+// Registers the four couplings of an element between bodies a and b.
+std::array<int, 4> couple(const std::vector<Body>& bodies, std::map<std::pair<int, int>, int>& index,
+                          std::vector<BlockPattern::Block>& blocks, int a, int b) {
+  const int fa = bodies[a].free_index, fb = bodies[b].free_index;
+  auto block = [&](int r, int c) {
+    if (r < 0 || c < 0) return -1;
+    auto [it, inserted] = index.try_emplace({r, c}, static_cast<int>(blocks.size()));
+    if (inserted) blocks.push_back({r, c});
+    return it->second;
+  };
+  return {block(fa, fa), block(fa, fb), block(fb, fa), block(fb, fb)};
+}
+
+}  // namespace
+
+void Model::finalize() {
+  free_bodies.clear();
+  for (int i = 0; i < static_cast<int>(bodies.size()); ++i) {
+    Body& b = bodies[i];
+    b.free_index = b.fixed ? -1 : static_cast<int>(free_bodies.size());
+    if (!b.fixed) free_bodies.push_back(i);
+  }
+  n_states = kStatesPerBody * n_free();
+  n_dofs = kDofsPerBody * n_free();
+
+  pattern = BlockPattern{};
+  std::map<std::pair<int, int>, int> index;
+  for (int k = 0; k < n_free(); ++k) {
+    index[{k, k}] = k;
+    pattern.blocks.push_back({k, k});
+  }
+  for (const Beam& e : beams)
+    pattern.beam_blocks.push_back(
+        couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
+  for (const Rail& e : rails)
+    pattern.rail_blocks.push_back(
+        couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
+}
+
+}  // namespace beamrail

@@ -1,0 +1,126 @@
+// Model: the immutable description of a scene, built once (by core/scene) and shared read-only by
+// every analysis and every thread. Everything mutable lives in Data (core/model/data.hpp).
+//
+// Units are SI throughout. Body 0 is the implicit fixed `ground` at the origin.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/model/time_function.hpp"
+#include "core/model/types.hpp"
+
+namespace beamrail {
+
+struct Body {
+  std::string name;
+  double mass = 0.0;                       // kg (0 for fixed bodies that were given none)
+  Mat3 inertia = Mat3::Zero();             // about the centre of mass, body axes [kg m^2]
+  Mat3 inertia_inverse = Mat3::Zero();     // its inverse (free bodies only)
+  Vec3 position = Vec3::Zero();            // initial centre of mass, global [m]
+  Vec4 orientation = Vec4(1, 0, 0, 0);     // initial Euler parameters (body -> global)
+  Vec3 velocity = Vec3::Zero();            // initial velocity of the centre of mass, global [m/s]
+  Vec3 angular_velocity = Vec3::Zero();    // initial angular velocity, body axes [rad/s]
+  bool fixed = false;
+  bool generated = false;                  // interior body of a segmented beam
+  double declared_mass = 0.0;              // the mass given in the scene, before segment masses
+  int free_index = -1;                     // position among the free bodies, -1 if fixed
+};
+
+// Where an element attaches to its two bodies; computed once at set-up (DESIGN.md §1).
+struct ElementEnds {
+  int body1 = 0, body2 = 0;        // body indices
+  Vec3 r1 = Vec3::Zero();          // point 1 in body-1 axes, from its centre of mass [m]
+  Vec3 r2 = Vec3::Zero();          // point 2 in body-2 axes [m]
+  Mat3 frame1 = Mat3::Identity();  // element frame in body-1 axes (A_bl_1)
+  Mat3 frame2 = Mat3::Identity();  // element frame in body-2 axes (A_bl_2)
+  double length = 0.0;             // |p2 - p1| in the initial configuration [m]
+};
+
+// Which of the two force laws of DESIGN.md §1 an element uses.
+enum class Formulation { kEnergy, kPaper };
+
+// Cross-section properties kept for stress recovery and mass.
+struct SectionProperties {
+  double area = 0.0;              // S [m^2]
+  double torsion_constant = 0.0;  // Ix [m^4]
+  double iy = 0.0, iz = 0.0;      // second moments about local y and z [m^4]
+  double wy = 0.0, wz = 0.0;      // section moduli about y and z [m^3]; 0 when unknown
+};
+
+struct Beam {
+  std::string name;
+  ElementEnds ends;
+  double ea = 0.0;              // E S [N]
+  double gj = 0.0;              // G Ix [N m^2]
+  double eiy = 0.0, eiz = 0.0;  // E Iy, E Iz [N m^2]
+  double damping = 0.0;         // stiffness-proportional beta [s]
+  Formulation formulation = Formulation::kEnergy;
+  SectionProperties section;
+  double density = 0.0;         // kg/m^3, 0 when not given
+  std::string group;            // the scene beam this element models (its own name if unsplit)
+  int segment = 0;              // 1..n for the segments of a split beam, 0 otherwise
+};
+
+enum class RailType { kPrismatic, kCylindrical };
+
+// A rail fixed to body 1 along its local x, on which body 2 (the carriage) slides.
+struct Rail {
+  std::string name;
+  RailType type = RailType::kPrismatic;
+  ElementEnds ends;             // ends.length: the initial carriage distance
+  double gj = 0.0;              // G Ix; 0 for cylindrical rails [N m^2]
+  double eiy = 0.0, eiz = 0.0;  // [N m^2]
+  double min_length = 0.0;      // floor of |l| [m]
+  double damping = 0.0;         // [s]
+  Formulation formulation = Formulation::kEnergy;
+  SectionProperties section;
+  double density = 0.0;
+};
+
+enum class LoadKind { kForce, kTorque };
+
+struct Load {
+  LoadKind kind = LoadKind::kForce;
+  int body = 0;
+  Vec3 offset = Vec3::Zero();  // force: point of application in body axes, from the centre [m]
+  Vec3 value = Vec3::Zero();   // global axes [N] or [N m], scaled by time(t)
+  TimeFunction time;
+};
+
+// Couplings between free bodies: the non-zero 6 x 6 blocks of tangent matrices, computed once.
+struct BlockPattern {
+  struct Block {
+    int row = 0, col = 0;  // free-body indices
+  };
+  std::vector<Block> blocks;        // diagonal blocks first (block k = free body k)
+  // Per element, the block index of (end a, end b) for a, b in {1, 2}, or -1 when either end is
+  // a fixed body: [0] = (1,1), [1] = (1,2), [2] = (2,1), [3] = (2,2).
+  std::vector<std::array<int, 4>> beam_blocks;
+  std::vector<std::array<int, 4>> rail_blocks;
+};
+
+struct Model {
+  std::vector<Body> bodies;  // [0] is ground
+  std::vector<Beam> beams;
+  std::vector<Rail> rails;
+  std::vector<Load> loads;
+  Vec3 gravity = Vec3::Zero();  // [m/s^2]
+
+  std::vector<int> free_bodies;  // body index of each free body, in state order
+  int n_states = 0;              // 13 per free body: c(3), q(4), v(3), w(3)
+  int n_dofs = 0;                // 6 per free body: dc(3), dtheta(3)
+  BlockPattern pattern;
+
+  int n_free() const { return static_cast<int>(free_bodies.size()); }
+
+  // Fills free_bodies, n_states, n_dofs and pattern from bodies, beams and rails. Called once by
+  // the scene loader after the element arrays are final.
+  void finalize();
+};
+
+constexpr int kStatesPerBody = 13;
+constexpr int kDofsPerBody = 6;
+
+}  // namespace beamrail

@@ -1,0 +1,114 @@
+// Rotations: Euler parameters (unit quaternions, scalar first), rotation matrices, skew matrices and
+// the small-rotation increments ("rotation vectors") used as generalized coordinates.
+//
+// Conventions: A(q) maps body axes to global axes. A rotation increment theta (global axes) changes
+// A to exp([theta]x) A, which in Euler parameters is q -> quat(theta) (x) q.
+#pragma once
+
+#include <cmath>
+
+#include "core/model/types.hpp"
+
+namespace beamrail {
+
+// The matrix [v]x with [v]x w = v x w.
+template <class T>
+Mat3T<T> skew(const Vec3T<T>& v) {
+  Mat3T<T> s;
+  s << T(0), -v(2), v(1), v(2), T(0), -v(0), -v(1), v(0), T(0);
+  return s;
+}
+
+// Body-to-global rotation matrix of the Euler parameters q; q need not be normalized (q/|q| is used).
+template <class T>
+Mat3T<T> rotation_matrix(const Vec4T<T>& q_raw) {
+  using std::sqrt;
+  const Vec4T<T> q = q_raw / sqrt(q_raw.squaredNorm());
+  const T q0 = q(0), q1 = q(1), q2 = q(2), q3 = q(3);
+  Mat3T<T> a;
+  a << q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, T(2) * (q1 * q2 - q0 * q3), T(2) * (q1 * q3 + q0 * q2),
+      T(2) * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3, T(2) * (q2 * q3 - q0 * q1),
+      T(2) * (q1 * q3 - q0 * q2), T(2) * (q2 * q3 + q0 * q1), q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3;
+  return a;
+}
+
+// Quaternion product a (x) b.
+inline Vec4 quat_multiply(const Vec4& a, const Vec4& b) {
+  Vec4 r;
+  r(0) = a(0) * b(0) - a.tail<3>().dot(b.tail<3>());
+  r.tail<3>() = a(0) * b.tail<3>() + b(0) * a.tail<3>() + a.tail<3>().cross(b.tail<3>());
+  return r;
+}
+
+// Euler parameters of the rotation exp([theta]x) (angle |theta| about theta/|theta|).
+inline Vec4 quat_from_rotation_vector(const Vec3& theta) {
+  const double angle = theta.norm();
+  Vec4 q;
+  if (angle < 1e-8) {
+    // Second-order series; exact to rounding below 1e-8 rad.
+    q(0) = 1.0 - angle * angle / 8.0;
+    q.tail<3>() = 0.5 * theta;
+  } else {
+    q(0) = std::cos(0.5 * angle);
+    q.tail<3>() = std::sin(0.5 * angle) / angle * theta;
+  }
+  return q;
+}
+
+// Euler parameters of a proper rotation matrix (Shepperd's method), q0 >= 0.
+inline Vec4 quat_from_rotation_matrix(const Mat3& a) {
+  const double tr = a.trace();
+  Vec4 q;
+  if (tr >= a(0, 0) && tr >= a(1, 1) && tr >= a(2, 2)) {
+    const double s = 2.0 * std::sqrt(1.0 + tr);
+    q << 0.25 * s, (a(2, 1) - a(1, 2)) / s, (a(0, 2) - a(2, 0)) / s, (a(1, 0) - a(0, 1)) / s;
+  } else if (a(0, 0) >= a(1, 1) && a(0, 0) >= a(2, 2)) {
+    const double s = 2.0 * std::sqrt(1.0 + 2.0 * a(0, 0) - tr);
+    q << (a(2, 1) - a(1, 2)) / s, 0.25 * s, (a(0, 1) + a(1, 0)) / s, (a(0, 2) + a(2, 0)) / s;
+  } else if (a(1, 1) >= a(2, 2)) {
+    const double s = 2.0 * std::sqrt(1.0 + 2.0 * a(1, 1) - tr);
+    q << (a(0, 2) - a(2, 0)) / s, (a(0, 1) + a(1, 0)) / s, 0.25 * s, (a(1, 2) + a(2, 1)) / s;
+  } else {
+    const double s = 2.0 * std::sqrt(1.0 + 2.0 * a(2, 2) - tr);
+    q << (a(1, 0) - a(0, 1)) / s, (a(0, 2) + a(2, 0)) / s, (a(1, 2) + a(2, 1)) / s, 0.25 * s;
+  }
+  if (q(0) < 0) q = -q;
+  return q / q.norm();
+}
+
+// The rotation vector of a proper rotation matrix (inverse of exp), angle in [0, pi].
+inline Vec3 rotation_vector(const Mat3& a) {
+  const Vec4 q = quat_from_rotation_matrix(a);
+  const double s = q.tail<3>().norm();
+  if (s < 1e-12) return 2.0 * q.tail<3>();
+  return 2.0 * std::atan2(s, q(0)) / s * q.tail<3>();
+}
+
+// d(theta)/dq: the global rotation increment produced by a change dq of (unnormalized) Euler
+// parameters, theta = 2 vec(dq (x) q*) / |q|^2  (3 x 4).
+inline Mat34 rotation_increment_jacobian(const Vec4& q) {
+  Mat34 h;
+  h.col(0) = -q.tail<3>();
+  h.rightCols<3>() = q(0) * Mat3::Identity() + skew<double>(q.tail<3>());
+  return (2.0 / q.squaredNorm()) * h;
+}
+
+// The 4 x 3 matrix Q(q) with q (x) (0, w) = Q(q) w.
+inline Mat43 quat_left_product_matrix(const Vec4& q) {
+  Mat43 m;
+  m.row(0) = -q.tail<3>().transpose();
+  m.bottomRows<3>() = q(0) * Mat3::Identity() + skew<double>(q.tail<3>());
+  return m;
+}
+
+// The 4 x 4 matrix R(w) with q (x) (0, w) = R(w) q.
+inline Mat4 quat_right_product_matrix(const Vec3& w) {
+  Mat4 m;
+  m(0, 0) = 0.0;
+  m.block<1, 3>(0, 1) = -w.transpose();
+  m.block<3, 1>(1, 0) = w;
+  m.block<3, 3>(1, 1) = -skew<double>(w);
+  return m;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,226 @@
+#include "core/scene/scene_loader.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include "core/model/rotation.hpp"
+#include "core/scene/scene_specs.hpp"
+
+namespace beamrail {
+namespace {
+
+// Inertia of a point mass with rotary inertia `inertia_local` (element axes, about the point).
+PointMass lumped(double mass, const Vec3& point, const Mat3& frame, const Vec3& inertia_local) {
+  return {mass, point, frame * inertia_local.asDiagonal() * frame.transpose()};
+}
+
+// Splits every segmented beam into `segments` sub-beams joined by generated interior bodies, and
+// collects the half-segment masses that go to the end bodies.
+void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>>& extra,
+                           std::vector<ElementSpec>& out) {
+  for (const ElementSpec& e : specs.elements) {
+    if (e.segments <= 0) {
+      out.push_back(e);
+      continue;
+    }
+    const long n = e.segments;
+    const Vec3 step = (e.p2 - e.p1) / static_cast<double>(n);
+    const double ls = step.norm();
+    const double rho = e.material.density;
+    const SectionProperties& s = e.section;
+    const double ms = rho * s.area * ls;
+    Diagnostics unused;  // the points were validated when read
+    const Mat3 frame = *element_frame(e.p1, e.p2, e.p3, e.where, unused);
+    // Rotary inertia of a slice of length a about its centre (element axes).
+    auto slice = [&](double a) {
+      const double m = rho * s.area * a;
+      return Vec3(rho * a * (s.iy + s.iz), rho * a * s.iy + m * a * a / 12.0,
+                  rho * a * s.iz + m * a * a / 12.0);
+    };
+    // Half segment about the end node: its slice inertia plus m (a/2)^2 for the bending axes.
+    Vec3 half = slice(0.5 * ls);
+    const double mh = 0.5 * ms;
+    half(1) += mh * 0.0625 * ls * ls;
+    half(2) += mh * 0.0625 * ls * ls;
+    if (!specs.bodies[e.body1].fixed) extra[e.body1].push_back(lumped(mh, e.p1, frame, half));
+    if (!specs.bodies[e.body2].fixed) extra[e.body2].push_back(lumped(mh, e.p2, frame, half));
+
+    // Interior bodies share the element's orientation; their velocities blend the ends'.
+    const BodySpec& b1 = specs.bodies[e.body1];
+    const BodySpec& b2 = specs.bodies[e.body2];
+    const Mat3 a1 = rotation_matrix<double>(b1.orientation), a2 = rotation_matrix<double>(b2.orientation);
+    const Vec3 om1 = a1 * b1.angular_velocity, om2 = a2 * b2.angular_velocity;
+    int previous = e.body1;
+    for (long k = 1; k <= n; ++k) {
+      int next = e.body2;
+      if (k < n) {
+        const double s_k = static_cast<double>(k) / static_cast<double>(n);
+        BodySpec node;
+        node.name = e.name + ".node" + std::to_string(k);
+        node.where = e.where;
+        node.generated = true;
+        node.position = e.p1 + static_cast<double>(k) * step;
+        node.orientation = quat_from_rotation_matrix(frame);
+        const Vec3 v1 = b1.velocity + om1.cross(node.position - b1.position);
+        const Vec3 v2 = b2.velocity + om2.cross(node.position - b2.position);
+        node.velocity = (1.0 - s_k) * v1 + s_k * v2;
+        node.angular_velocity = frame.transpose() * ((1.0 - s_k) * om1 + s_k * om2);
+        node.mass = ms;
+        const Vec3 j = slice(ls);
+        node.inertia = Mat3(j.asDiagonal());
+        next = static_cast<int>(specs.bodies.size());
+        specs.bodies.push_back(node);
+        extra.emplace_back();
+      }
+      ElementSpec sub = e;
+      sub.name = e.name + ".seg" + std::to_string(k);
+      sub.segments = -k;  // marks "segment k of e.name"
+      sub.body1 = previous, sub.body2 = next;
+      sub.p1 = e.p1 + static_cast<double>(k - 1) * step;
+      sub.p2 = sub.p1 + step;
+      sub.p3 = e.p3 + static_cast<double>(k - 1) * step;
+      out.push_back(sub);
+      previous = next;
+    }
+  }
+}
+
+// Combines a body's own mass with the lumped masses of segments into one rigid body; returns the
+// combined centre of mass and sets mass and inertia (body axes).
+Vec3 combine_masses(const BodySpec& b, const std::vector<PointMass>& extra, double* mass,
+                    Mat3* inertia) {
+  const Mat3 a = rotation_matrix<double>(b.orientation);
+  std::vector<PointMass> parts = extra;
+  if (b.mass) parts.push_back({*b.mass, b.position, a * b.inertia.value_or(Mat3::Zero()) * a.transpose()});
+  double m = 0.0;
+  Vec3 first = Vec3::Zero();
+  for (const PointMass& p : parts) m += p.mass, first += p.mass * p.point;
+  const Vec3 c = m > 0.0 ? Vec3(first / m) : b.position;
+  Mat3 j = Mat3::Zero();
+  for (const PointMass& p : parts) {
+    const Vec3 d = p.point - c;
+    j += p.inertia + p.mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+  }
+  *mass = m;
+  *inertia = a.transpose() * j * a;
+  return c;
+}
+
+ElementEnds make_ends(const ElementSpec& e, const std::vector<Body>& bodies) {
+  ElementEnds ends;
+  ends.body1 = e.body1;
+  ends.body2 = e.body2;
+  Diagnostics unused;  // the points were validated when read
+  const Mat3 frame = *element_frame(e.p1, e.p2, e.p3, e.where, unused);
+  const Body& b1 = bodies[e.body1];
+  const Body& b2 = bodies[e.body2];
+  const Mat3 a1 = rotation_matrix<double>(b1.orientation), a2 = rotation_matrix<double>(b2.orientation);
+  ends.r1 = a1.transpose() * (e.p1 - b1.position);
+  ends.r2 = a2.transpose() * (e.p2 - b2.position);
+  ends.frame1 = a1.transpose() * frame;
+  ends.frame2 = a2.transpose() * frame;
+  ends.length = (e.p2 - e.p1).norm();
+  return ends;
+}
+
+}  // namespace
+
+std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnostics& diag) {
+  const size_t errors_before = diag.size();
+  SceneSpecs specs;
+  {
+    ObjectReader r(scene, where, diag);
+    if (!r.is_object()) return std::nullopt;
+    specs.gravity = r.vec3("gravity", false).value_or(Vec3::Zero());
+    read_materials(r, specs);
+    read_sections(r, specs);
+    read_bodies(r, specs);
+    read_elements(r, specs, false);
+    read_elements(r, specs, true);
+    read_loads(r, specs);
+  }
+  if (diag.size() > errors_before) return std::nullopt;
+
+  std::vector<std::vector<PointMass>> extra(specs.bodies.size());
+  std::vector<ElementSpec> elements;
+  split_segmented_beams(specs, extra, elements);
+
+  Model model;
+  model.gravity = specs.gravity;
+  for (size_t i = 0; i < specs.bodies.size(); ++i) {
+    const BodySpec& s = specs.bodies[i];
+    Body b;
+    b.name = s.name;
+    b.fixed = s.fixed;
+    b.generated = s.generated;
+    b.declared_mass = b.generated ? 0.0 : s.mass.value_or(0.0);
+    b.orientation = s.orientation;
+    b.velocity = s.velocity;
+    b.angular_velocity = s.angular_velocity;
+    b.position = combine_masses(s, extra[i], &b.mass, &b.inertia);
+    if (!b.fixed) {
+      const Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia);
+      if (!(b.mass > 0.0) || !(eig.eigenvalues().minCoeff() > 0.0)) {
+        diag.error(s.where.file, s.where.pointer,
+                   "free body \"" + s.name +
+                       "\" has no mass: give \"mass\" and \"inertia\", attach a segmented beam, or "
+                       "set \"fixed\": true");
+        continue;
+      }
+      b.inertia_inverse = b.inertia.inverse();
+    }
+    model.bodies.push_back(b);
+  }
+  if (diag.size() > errors_before) return std::nullopt;
+
+  for (const ElementSpec& e : elements) {
+    const ElementEnds ends = make_ends(e, model.bodies);
+    const double modulus_e = e.material.e, modulus_g = e.material.g;
+    if (!e.rail) {
+      Beam b;
+      b.name = e.name;
+      b.group = e.segments < 0 ? e.name.substr(0, e.name.rfind(".seg")) : e.name;
+      b.segment = e.segments < 0 ? static_cast<int>(-e.segments) : 0;
+      b.ends = ends;
+      b.ea = modulus_e * e.section.area;
+      b.gj = modulus_g * e.section.torsion_constant;
+      b.eiy = modulus_e * e.section.iy;
+      b.eiz = modulus_e * e.section.iz;
+      b.damping = e.damping;
+      b.formulation = e.formulation;
+      b.section = e.section;
+      b.density = e.material.density;
+      model.beams.push_back(b);
+    } else {
+      Rail r;
+      r.name = e.name;
+      r.type = e.rail_type;
+      r.ends = ends;
+      r.gj = e.rail_type == RailType::kPrismatic ? modulus_g * e.section.torsion_constant : 0.0;
+      r.eiy = modulus_e * e.section.iy;
+      r.eiz = modulus_e * e.section.iz;
+      r.min_length = e.min_length.value_or(1e-3 * ends.length);
+      r.damping = e.damping;
+      r.formulation = e.formulation;
+      r.section = e.section;
+      r.density = e.material.density;
+      model.rails.push_back(r);
+    }
+  }
+
+  for (size_t k = 0; k < specs.loads.size(); ++k) {
+    Load load = specs.loads[k];
+    const Body& b = model.bodies[load.body];
+    load.offset = rotation_matrix<double>(b.orientation).transpose() * (specs.load_points[k] - b.position);
+    model.loads.push_back(load);
+  }
+
+  model.finalize();
+  if (model.n_free() == 0) {
+    diag.error(where.file, (where / "bodies").pointer,
+               "the scene has no free body: nothing can move (every body is fixed or none is given)");
+    return std::nullopt;
+  }
+  return model;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,350 @@
+// Readers of the scene's materials, sections, bodies, beams, rails and loads.
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "core/model/rotation.hpp"
+#include "core/model/section.hpp"
+#include "core/scene/scene_specs.hpp"
+
+namespace beamrail {
+namespace {
+
+std::string number_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+// Iterates the members of an optional object member; reports a non-object.
+template <class F>
+void for_each_member(ObjectReader& parent, const std::string& key, F&& f) {
+  const Json* obj = parent.member(key, false);
+  if (!obj) return;
+  if (!obj->is_object()) {
+    parent.error(key, "expected an object of named entries, got " + json_type_name(*obj));
+    return;
+  }
+  for (const auto& item : obj->items()) f(item.key(), item.value(), parent.at(key) / item.key());
+}
+
+// Iterates the entries of an optional array member; reports a non-array.
+template <class F>
+void for_each_entry(ObjectReader& parent, const std::string& key, F&& f) {
+  const Json* arr = parent.member(key, false);
+  if (!arr) return;
+  if (!arr->is_array()) {
+    parent.error(key, "expected an array, got " + json_type_name(*arr));
+    return;
+  }
+  for (size_t i = 0; i < arr->size(); ++i) f((*arr)[i], parent.at(key) / i);
+}
+
+std::optional<SectionProperties> read_section(ObjectReader& r) {
+  const auto shape =
+      r.choice("shape", true, {"rectangle", "circle", "tube", "box", "custom"});
+  if (!shape) return std::nullopt;
+  if (*shape == "rectangle") {
+    const auto w = r.positive("width", true), h = r.positive("height", true);
+    if (w && h) return rectangle_section(*w, *h);
+  } else if (*shape == "circle") {
+    if (const auto d = r.positive("diameter", true)) return circle_section(*d);
+  } else if (*shape == "tube") {
+    const auto d = r.positive("outer_diameter", true), t = r.positive("wall", true);
+    if (d && t) {
+      if (*t < 0.5 * *d) return tube_section(*d, *t);
+      r.error("wall", "must be less than half the outer diameter (" + number_text(*d / 2) + ")");
+    }
+  } else if (*shape == "box") {
+    const auto w = r.positive("width", true), h = r.positive("height", true);
+    const auto t = r.positive("wall", true);
+    if (w && h && t) {
+      if (*t < 0.5 * std::min(*w, *h)) return box_section(*w, *h, *t);
+      r.error("wall", "must be less than half the smaller of width and height");
+    }
+  } else {
+    SectionProperties s;
+    const auto area = r.positive("S", true), ix = r.positive("Ix", true);
+    const auto iy = r.positive("Iy", true), iz = r.positive("Iz", true);
+    const auto wy = r.positive("Wy", false), wz = r.positive("Wz", false);
+    if (area && ix && iy && iz) {
+      s.area = *area, s.torsion_constant = *ix, s.iy = *iy, s.iz = *iz;
+      s.wy = wy.value_or(0.0), s.wz = wz.value_or(0.0);
+      return s;
+    }
+  }
+  return std::nullopt;
+}
+
+// Principal inertias [J1, J2, J3] or a tensor [xx, yy, zz, xy, xz, yz]: positive definite and
+// satisfying the triangle inequality J_i + J_j >= J_k.
+std::optional<Mat3> read_inertia(ObjectReader& r) {
+  const Json* v = r.member("inertia", false);
+  if (!v) return std::nullopt;
+  const Where at = r.at("inertia");
+  if (!v->is_array() || (v->size() != 3 && v->size() != 6)) {
+    r.error("inertia", "expected 3 principal values or 6 tensor components [xx, yy, zz, xy, xz, yz]");
+    return std::nullopt;
+  }
+  std::vector<double> x;
+  for (size_t i = 0; i < v->size(); ++i) {
+    const auto n = read_number((*v)[i], at / i, r.diagnostics());
+    if (!n) return std::nullopt;
+    x.push_back(*n);
+  }
+  Mat3 j = Mat3::Zero();
+  j.diagonal() << x[0], x[1], x[2];
+  if (x.size() == 6) {
+    j(0, 1) = j(1, 0) = x[3];
+    j(0, 2) = j(2, 0) = x[4];
+    j(1, 2) = j(2, 1) = x[5];
+  }
+  const Vec3 p = Eigen::SelfAdjointEigenSolver<Mat3>(j).eigenvalues();
+  if (!(p.minCoeff() > 0.0)) {
+    r.error("inertia", x.size() == 3 ? "principal inertias must be > 0"
+                                     : "inertia tensor must be positive definite");
+    return std::nullopt;
+  }
+  const double tol = 1e-9 * p.sum();
+  if (p(0) + p(1) < p(2) - tol) {
+    r.error("inertia", "principal inertias violate the triangle inequality (" +
+                           number_text(p(0)) + " + " + number_text(p(1)) + " < " +
+                           number_text(p(2)) + "): no rigid body has them");
+    return std::nullopt;
+  }
+  return j;
+}
+
+std::optional<TimeFunction> read_time_function(const Json& value, const Where& where,
+                                               Diagnostics& diag) {
+  ObjectReader r(value, where, diag);
+  if (!r.is_object()) return std::nullopt;
+  TimeFunction f;
+  const auto type = r.choice("type", true, {"constant", "step", "ramp", "harmonic", "table"});
+  if (!type) return std::nullopt;
+  if (*type == "constant") return f;
+  if (*type == "step") {
+    f.type = TimeFunction::Type::kStep;
+    f.at = r.number_or("at", 0.0);
+    return f;
+  }
+  if (*type == "ramp") {
+    f.type = TimeFunction::Type::kRamp;
+    const auto from = r.number("from", true), to = r.number("to", true);
+    if (!from || !to) return std::nullopt;
+    if (*to <= *from) {
+      r.error("to", "must be greater than \"from\"");
+      return std::nullopt;
+    }
+    f.from = *from, f.to = *to;
+    return f;
+  }
+  if (*type == "harmonic") {
+    f.type = TimeFunction::Type::kHarmonic;
+    const auto freq = r.positive("frequency", true);
+    f.phase = r.number_or("phase", 0.0);
+    if (!freq) return std::nullopt;
+    f.frequency = *freq;
+    return f;
+  }
+  f.type = TimeFunction::Type::kTable;
+  const auto t = r.numbers("t", true, -1), v = r.numbers("v", true, -1);
+  if (!t || !v) return std::nullopt;
+  if (t->size() != v->size()) {
+    r.error("v", "must have as many values as \"t\" (" + std::to_string(t->size()) + ")");
+    return std::nullopt;
+  }
+  for (size_t i = 1; i < t->size(); ++i)
+    if (!((*t)[i] > (*t)[i - 1])) {
+      diag.error(where.file, (where / "t" / i).pointer, "times must be strictly increasing");
+      return std::nullopt;
+    }
+  f.t = *t, f.v = *v;
+  return f;
+}
+
+// Resolves a body name ("ground" or a scene body).
+std::optional<int> body_ref(ObjectReader& r, const std::string& key, const SceneSpecs& specs) {
+  const auto name = r.string(key, true);
+  if (!name) return std::nullopt;
+  const auto it = specs.body_index.find(*name);
+  if (it == specs.body_index.end()) {
+    r.error(key, "unknown body \"" + *name + "\"");
+    return std::nullopt;
+  }
+  return it->second;
+}
+
+}  // namespace
+
+void read_materials(ObjectReader& scene, SceneSpecs& specs) {
+  for_each_member(scene, "materials", [&](const std::string& name, const Json& v, const Where& at) {
+    ObjectReader r(v, at, scene.diagnostics());
+    const auto e = r.positive("E", true), g = r.positive("G", true);
+    const auto rho = r.positive("density", false, true);
+    if (e && g) specs.materials[name] = {*e, *g, rho.value_or(0.0)};
+  });
+}
+
+void read_sections(ObjectReader& scene, SceneSpecs& specs) {
+  for_each_member(scene, "sections", [&](const std::string& name, const Json& v, const Where& at) {
+    ObjectReader r(v, at, scene.diagnostics());
+    if (!r.is_object()) return;
+    if (const auto s = read_section(r)) specs.sections[name] = *s;
+  });
+}
+
+void read_bodies(ObjectReader& scene, SceneSpecs& specs) {
+  BodySpec ground;
+  ground.name = "ground";
+  ground.fixed = true;
+  specs.bodies.push_back(ground);
+  specs.body_index["ground"] = 0;
+  Diagnostics& diag = scene.diagnostics();
+  for_each_entry(scene, "bodies", [&](const Json& v, const Where& at) {
+    ObjectReader r(v, at, diag);
+    if (!r.is_object()) return;
+    BodySpec b;
+    b.where = at;
+    const auto name = r.string("name", true);
+    b.fixed = r.boolean("fixed", false).value_or(false);
+    b.mass = r.positive("mass", false);
+    b.inertia = read_inertia(r);
+    const auto position = r.vec3("position", true);
+    const auto orientation = r.numbers("orientation", false, 4);
+    b.velocity = r.vec3("velocity", false).value_or(Vec3::Zero());
+    b.angular_velocity = r.vec3("angular_velocity", false).value_or(Vec3::Zero());
+    if (position) b.position = *position;
+    if (orientation) {
+      const Vec4 q((*orientation)[0], (*orientation)[1], (*orientation)[2], (*orientation)[3]);
+      if (std::abs(q.norm() - 1.0) > 1e-3)
+        r.error("orientation", "Euler parameters must have unit norm (norm is " +
+                                   number_text(q.norm()) + ")");
+      else
+        b.orientation = q / q.norm();
+    }
+    if (b.mass && !b.inertia && !b.fixed) r.error("inertia", "a free body with a mass needs an inertia");
+    if (b.inertia && !b.mass && !b.fixed) r.error("mass", "a free body with an inertia needs a mass");
+    if (!name) return;
+    b.name = *name;
+    if (b.name.empty()) {
+      r.error("name", "must not be empty");
+    } else if (specs.body_index.count(b.name)) {
+      r.error("name", b.name == "ground" ? "\"ground\" is the implicit fixed body; choose another name"
+                                         : "duplicate body name \"" + b.name + "\"");
+    } else {
+      specs.body_index[b.name] = static_cast<int>(specs.bodies.size());
+      specs.bodies.push_back(b);
+    }
+  });
+}
+
+std::optional<Mat3> element_frame(const Vec3& p1, const Vec3& p2, const Vec3& p3,
+                                  const Where& where, Diagnostics& diag) {
+  const Vec3 d = p2 - p1;
+  const double length = d.norm();
+  const double scale = std::max({p1.norm(), p2.norm(), p3.norm()});
+  if (!(length > 1e-12 * scale) || length == 0.0) {
+    diag.error(where.file, (where / "point2").pointer, "point1 and point2 coincide");
+    return std::nullopt;
+  }
+  const Vec3 x = d / length;
+  const Vec3 off = p3 - p1;
+  const Vec3 y = off - off.dot(x) * x;
+  if (!(y.norm() > 1e-9 * std::max(length, off.norm()))) {
+    diag.error(where.file, (where / "point3").pointer,
+               "point3 lies on the axis through point1 and point2; it must be off the axis to "
+               "fix the section's y axis");
+    return std::nullopt;
+  }
+  Mat3 frame;
+  frame.col(0) = x;
+  frame.col(1) = y.normalized();
+  frame.col(2) = x.cross(frame.col(1));
+  return frame;
+}
+
+void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
+  Diagnostics& diag = scene.diagnostics();
+  for_each_entry(scene, rails ? "rails" : "beams", [&](const Json& v, const Where& at) {
+    ObjectReader r(v, at, diag);
+    if (!r.is_object()) return;
+    ElementSpec e;
+    e.where = at;
+    e.rail = rails;
+    const auto name = r.string("name", true);
+    if (rails) {
+      const auto type = r.choice("type", true, {"prismatic", "cylindrical"});
+      if (type) e.rail_type = *type == "prismatic" ? RailType::kPrismatic : RailType::kCylindrical;
+    }
+    const auto b1 = body_ref(r, "body1", specs), b2 = body_ref(r, "body2", specs);
+    const auto p1 = r.vec3("point1", true), p2 = r.vec3("point2", true);
+    const auto p3 = r.vec3("point3", true);
+    const auto material = r.string("material", true), section = r.string("section", true);
+    e.damping = r.positive("damping", false, true).value_or(0.0);
+    const auto form = r.choice("formulation", false, {"energy", "paper"});
+    if (form && *form == "paper") e.formulation = Formulation::kPaper;
+    e.segments = r.integer("segments", false, 0).value_or(0);
+    if (rails) e.min_length = r.positive("min_length", false);
+    bool ok = name && b1 && b2 && p1 && p2 && p3 && material && section;
+    if (material && !specs.materials.count(*material)) {
+      r.error("material", "unknown material \"" + *material + "\"");
+      ok = false;
+    }
+    if (section && !specs.sections.count(*section)) {
+      r.error("section", "unknown section \"" + *section + "\"");
+      ok = false;
+    }
+    if (b1 && b2 && *b1 == *b2) {
+      r.error("body2", "an element must join two different bodies");
+      ok = false;
+    }
+    if (p1 && p2 && p3 && !element_frame(*p1, *p2, *p3, at, diag)) ok = false;
+    if (rails && e.segments > 0) {
+      r.error("segments", "rails cannot be segmented: the carriage slides along them");
+      ok = false;
+    }
+    if (ok && e.segments > 0 && specs.materials.at(*material).density <= 0.0) {
+      r.error("segments", "a segmented beam needs a material with a density > 0");
+      ok = false;
+    }
+    if (!ok) return;
+    for (const ElementSpec& other : specs.elements)
+      if (other.name == *name) {
+        r.error("name", "duplicate element name \"" + *name + "\" (beams and rails share names)");
+        return;
+      }
+    e.name = *name, e.body1 = *b1, e.body2 = *b2, e.p1 = *p1, e.p2 = *p2, e.p3 = *p3;
+    e.material = specs.materials.at(*material);
+    e.section = specs.sections.at(*section);
+    specs.elements.push_back(e);
+  });
+}
+
+void read_loads(ObjectReader& scene, SceneSpecs& specs) {
+  Diagnostics& diag = scene.diagnostics();
+  for_each_entry(scene, "loads", [&](const Json& v, const Where& at) {
+    ObjectReader r(v, at, diag);
+    if (!r.is_object()) return;
+    Load load;
+    const auto type = r.choice("type", true, {"force", "torque"});
+    const auto body = body_ref(r, "body", specs);
+    std::optional<Vec3> point;
+    if (type && *type == "force") point = r.vec3("point", false);
+    const auto value = r.vec3("value", true);
+    std::optional<TimeFunction> time = TimeFunction{};
+    if (const Json* t = r.member("time", false)) time = read_time_function(*t, at / "time", diag);
+    if (body && specs.bodies[*body].fixed) {
+      r.error("body", "body \"" + specs.bodies[*body].name + "\" is fixed: a load on it does nothing");
+      return;
+    }
+    if (!type || !body || !value || !time) return;
+    load.kind = *type == "force" ? LoadKind::kForce : LoadKind::kTorque;
+    load.body = *body;
+    load.value = *value;
+    load.time = *time;
+    specs.loads.push_back(load);
+    specs.load_points.push_back(point.value_or(specs.bodies[*body].position));
+  });
+}
+
+}  // namespace beamrail

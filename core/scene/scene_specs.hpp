@@ -1,0 +1,78 @@
+// Intermediate, validated descriptions of scene parts, read from JSON before the Model is built
+// (segment masses must be known before centres of mass and attachment offsets are fixed).
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/model/model.hpp"
+#include "core/scene/json_reader.hpp"
+
+namespace beamrail {
+
+struct MaterialSpec {
+  double e = 0.0, g = 0.0;  // [Pa]
+  double density = 0.0;     // [kg/m^3], 0 when not given
+};
+
+struct BodySpec {
+  std::string name;
+  Where where;
+  bool fixed = false;
+  bool generated = false;  // interior node of a segmented beam
+  std::optional<double> mass;
+  std::optional<Mat3> inertia;  // body axes
+  Vec3 position = Vec3::Zero();
+  Vec4 orientation = Vec4(1, 0, 0, 0);
+  Vec3 velocity = Vec3::Zero(), angular_velocity = Vec3::Zero();
+};
+
+// A lumped mass added to a body by a segmented beam: mass at a global point, inertia about that
+// point in global axes.
+struct PointMass {
+  double mass = 0.0;
+  Vec3 point = Vec3::Zero();
+  Mat3 inertia = Mat3::Zero();
+};
+
+struct ElementSpec {
+  std::string name;
+  Where where;
+  bool rail = false;
+  RailType rail_type = RailType::kPrismatic;
+  int body1 = 0, body2 = 0;  // indices into the body list (0 = ground)
+  Vec3 p1, p2, p3;
+  MaterialSpec material;
+  SectionProperties section;
+  double damping = 0.0;
+  Formulation formulation = Formulation::kEnergy;
+  long segments = 0;
+  std::optional<double> min_length;
+};
+
+struct SceneSpecs {
+  Vec3 gravity = Vec3::Zero();
+  std::map<std::string, MaterialSpec> materials;
+  std::map<std::string, SectionProperties> sections;
+  std::vector<BodySpec> bodies;  // [0] is ground
+  std::map<std::string, int> body_index;
+  std::vector<ElementSpec> elements;
+  std::vector<Load> loads;
+  std::vector<Vec3> load_points;  // global application point of each load
+};
+
+// Readers for each part of a scene; each reports its own problems.
+void read_materials(ObjectReader& scene, SceneSpecs& specs);
+void read_sections(ObjectReader& scene, SceneSpecs& specs);
+void read_bodies(ObjectReader& scene, SceneSpecs& specs);
+void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails);
+void read_loads(ObjectReader& scene, SceneSpecs& specs);
+
+// The element frame (columns x, y, z in global axes) of points 1, 2, 3; nullopt when points 1
+// and 2 coincide or point 3 lies on the axis (reported at `where`).
+std::optional<Mat3> element_frame(const Vec3& p1, const Vec3& p2, const Vec3& p3,
+                                  const Where& where, Diagnostics& diag);
+
+}  // namespace beamrail

@@ -10,6 +10,7 @@ Data::Data(const Model& model)
       w(model.bodies.size()),
       wrench(model.bodies.size(), Vec6::Zero()),
       rail_floored(model.rails.size(), 0),
+      rail_floored_ever(model.rails.size(), 0),
       stiffness(model.pattern.blocks.size(), Mat6::Zero()),
       damping(model.pattern.blocks.size(), Mat6::Zero()) {
   for (size_t i = 0; i < model.bodies.size(); ++i) {

@@ -19,6 +19,7 @@ struct Data {
   std::vector<Vec6> wrench;        // per body: force and moment about the centre, global [N, N m]
   double elastic_energy = 0.0;     // sum of element strain energies [J]
   std::vector<char> rail_floored;  // per rail: |l| was at min_length in the last evaluation
+  std::vector<char> rail_floored_ever;  // per rail: ... in any evaluation so far
 
   // Tangent blocks, one per model.pattern block (row body, column body):
   std::vector<Mat6> stiffness;  // d wrench_row / d (dc, dtheta)_col  [N/m, N, N m]

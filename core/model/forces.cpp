@@ -52,6 +52,7 @@ void compute_wrenches(const Model& model, Data& data, double t) {
     energy += rail_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2],
                             &floored);
     data.rail_floored[r] = floored;
+    if (floored) data.rail_floored_ever[r] = 1;
   }
   data.elastic_energy = energy;
   ++data.n_wrench_evaluations;

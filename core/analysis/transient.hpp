@@ -1,0 +1,70 @@
+// Transient analysis (DESIGN.md §2): integrates the equations of motion of the free bodies from
+// the Model's initial state with CVODE (BDF, Newton iterations, exact Jacobian by automatic
+// differentiation), keeping |q| = 1 by CVODE's projection, and reports a sample at every output
+// step.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/model/data.hpp"
+#include "core/model/model.hpp"
+
+namespace beamrail {
+
+enum class JacobianKind { kExact, kFiniteDifference };
+enum class LinearSolverKind { kAuto, kDense, kSparse };
+
+struct IntegratorOptions {
+  std::string method = "bdf";
+  double rtol = 1e-6;   // relative tolerance
+  double atol = 1e-9;   // absolute tolerance (states in m, -, m/s, rad/s)
+  JacobianKind jacobian = JacobianKind::kExact;
+  LinearSolverKind linear_solver = LinearSolverKind::kAuto;
+  int max_order = 5;            // BDF order limit, 1..5
+  double max_step = 0.0;        // [s]; 0: no limit
+  double initial_step = 0.0;    // [s]; 0: the integrator's estimate
+  long max_steps = 10000000;    // total step budget over the run
+};
+
+struct TransientOptions {
+  double t_end = 1.0;        // [s]
+  double output_step = 0.01; // [s]
+  IntegratorOptions integrator;
+};
+
+// Energies at one output time [J].
+struct TransientSample {
+  double t = 0.0;
+  double kinetic = 0.0, elastic = 0.0, gravity = 0.0;
+  double energy() const { return kinetic + elastic + gravity; }
+};
+
+struct SolverStats {
+  double wall_seconds = 0.0;
+  long steps = 0;
+  long rhs_evaluations = 0;       // including those for finite-difference Jacobians
+  long jacobian_evaluations = 0;
+  long nonlinear_iterations = 0;
+  long nonlinear_failures = 0;
+  long error_test_failures = 0;
+};
+
+struct TransientResult {
+  bool ok = false;
+  std::string message;     // why it stopped early, when !ok
+  double t_reached = 0.0;  // last time integrated to [s]
+  SolverStats stats;
+  std::vector<std::string> warnings;
+};
+
+using TransientObserver = std::function<void(const TransientSample&, const Data&)>;
+
+// Runs the analysis; observer sees t = 0 and every output step (data holds that state). Never
+// throws: failures (solver, non-finite forces, observer errors) come back in the result, after the
+// samples reached so far were delivered.
+TransientResult run_transient(const Model& model, const TransientOptions& options, Data& data,
+                              const TransientObserver& observer);
+
+}  // namespace beamrail

@@ -1,0 +1,177 @@
+#include "optimizer/cli/cli.hpp"
+
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <new>
+
+#include "optimizer/evaluation.hpp"
+#include "optimizer/study.hpp"
+#include "optimizer/summary.hpp"
+#include "optimizer/tables.hpp"
+#include "optimizer/version.hpp"
+
+namespace beamrail {
+namespace {
+
+constexpr const char* kUsage = R"(beamrail - design optimizer for rigid bodies joined by elastic beams and rails
+
+Usage:
+  beamrail run STUDY.json [-o OUTDIR] [-j THREADS] [--resume] [--quiet]
+  beamrail check STUDY.json
+  beamrail --help | --version
+
+Commands:
+  run     validate the study, run its analyses and write the result tables to OUTDIR
+          (default: results/<study name>/): summary.json, timeseries.csv, ...
+  check   validate the study only; list every problem as file:/json/pointer: message
+
+Options:
+  -o, --output OUTDIR   where to write the results
+  -j, --threads N       threads for batch evaluation (default: all cores)
+  --resume              continue an interrupted run in OUTDIR
+  --quiet               no progress output
+
+Exit status: 0 success; 1 a run failed (the reason is printed, partial tables are kept);
+2 bad input (unreadable or invalid study, bad command line).
+)";
+
+struct RunArguments {
+  std::string study;
+  std::string output;
+  int threads = 0;
+  bool resume = false;
+  bool quiet = false;
+};
+
+int usage_error(const std::string& message) {
+  std::cerr << "beamrail: " << message << "\n\n" << kUsage;
+  return 2;
+}
+
+// Parses the arguments after "run" or "check"; returns an exit status on error.
+std::optional<int> parse_run_arguments(const std::vector<std::string>& args, bool run,
+                                       RunArguments& out) {
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](const char* what) -> std::optional<std::string> {
+      if (i + 1 >= args.size()) return std::nullopt;
+      (void)what;
+      return args[++i];
+    };
+    if (run && (a == "-o" || a == "--output")) {
+      const auto v = value("OUTDIR");
+      if (!v || v->empty()) return usage_error(a + " needs a directory");
+      out.output = *v;
+    } else if (run && (a == "-j" || a == "--threads")) {
+      const auto v = value("N");
+      try {
+        size_t used = 0;
+        out.threads = v ? std::stoi(*v, &used) : -1;
+        if (!v || used != v->size() || out.threads < 1) throw std::invalid_argument("");
+      } catch (const std::exception&) {
+        return usage_error(a + " needs a positive number of threads");
+      }
+    } else if (run && a == "--resume") {
+      out.resume = true;
+    } else if (run && a == "--quiet") {
+      out.quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage_error("unknown option " + a);
+    } else if (out.study.empty()) {
+      out.study = a;
+    } else {
+      return usage_error("more than one study file given");
+    }
+  }
+  if (out.study.empty()) return usage_error("no study file given");
+  return std::nullopt;
+}
+
+int check(const RunArguments& args) {
+  Diagnostics diag;
+  const auto study = load_study_file(args.study, diag);
+  if (!study) {
+    std::cerr << diag.format();
+    return 2;
+  }
+  const Model& m = study->model;
+  std::cout << args.study << ": ok (" << m.bodies.size() - 1 << " bodies, " << m.beams.size()
+            << " beams, " << m.rails.size() << " rails, " << m.n_states << " states, "
+            << study->analyses.size() << " analyses, " << study->responses.size()
+            << " responses)\n";
+  return 0;
+}
+
+int run(const RunArguments& args) {
+  Diagnostics diag;
+  const auto study = load_study_file(args.study, diag);
+  if (!study) {
+    std::cerr << diag.format();
+    return 2;
+  }
+  const std::filesystem::path out =
+      args.output.empty() ? std::filesystem::path("results") / study->name
+                          : std::filesystem::path(args.output);
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (ec || !std::filesystem::is_directory(out)) {
+    std::cerr << "beamrail: cannot create the output directory " << out << ": " << ec.message()
+              << "\n";
+    return 1;
+  }
+
+  const Evaluation ev = evaluate(*study, study->model, {out});
+  const nlohmann::json summary = evaluation_summary(*study, study->model, ev);
+  std::string error;
+  if (!write_file_atomically(out / "summary.json", summary.dump(2) + "\n", &error)) {
+    std::cerr << "beamrail: " << error << "\n";
+    return 1;
+  }
+  for (const std::string& w : ev.warnings) std::cerr << "warning: " << w << "\n";
+  if (ev.status != "ok") {
+    std::cerr << "beamrail: " << study->name << " " << ev.status << ": " << ev.message
+              << "\n(partial results kept in " << out.string() << ")\n";
+    return 1;
+  }
+  std::cout << study->name << ": ok in " << ev.wall_seconds << " s -> " << out.string() << "\n";
+  for (size_t k = 0; k < study->responses.size(); ++k)
+    std::cout << "  " << study->responses[k].name << " = " << format_number(ev.responses[k])
+              << "\n";
+  return 0;
+}
+
+int dispatch(const std::vector<std::string>& args) {
+  if (args.empty()) return usage_error("no command given");
+  const std::string& command = args[0];
+  if (command == "--help" || command == "-h" || command == "help") {
+    std::cout << kUsage;
+    return 0;
+  }
+  if (command == "--version") {
+    std::cout << "beamrail " << kVersion << "\n";
+    return 0;
+  }
+  if (command != "run" && command != "check") return usage_error("unknown command " + command);
+  RunArguments parsed;
+  if (const auto status = parse_run_arguments(args, command == "run", parsed)) return *status;
+  return command == "run" ? run(parsed) : check(parsed);
+}
+
+}  // namespace
+
+int run_command_line(const std::vector<std::string>& args) {
+  try {
+    return dispatch(args);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "beamrail: out of memory\n";
+  } catch (const std::exception& e) {
+    std::cerr << "beamrail: internal error: " << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "beamrail: internal error\n";
+  }
+  return 1;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,13 @@
+// The beamrail command line (SPEC.md "Command line").
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace beamrail {
+
+// Runs the command line with arguments args (without the program name). Returns the exit status:
+// 0 success, 1 a run failed, 2 bad input or usage. Never throws.
+int run_command_line(const std::vector<std::string>& args);
+
+}  // namespace beamrail

@@ -1,0 +1,65 @@
+#include "optimizer/summary.hpp"
+
+#include <cmath>
+
+#include "optimizer/version.hpp"
+
+namespace beamrail {
+
+nlohmann::json json_number(double x) {
+  if (!std::isfinite(x)) return nullptr;
+  return x;
+}
+
+nlohmann::json model_summary(const Model& model) {
+  int generated = 0;
+  for (const Body& b : model.bodies) generated += b.generated;
+  return {{"bodies", static_cast<int>(model.bodies.size()) - 1 - generated},
+          {"generated_bodies", generated},
+          {"free_bodies", model.n_free()},
+          {"beams", model.beams.size()},
+          {"rails", model.rails.size()},
+          {"loads", model.loads.size()},
+          {"states", model.n_states},
+          {"degrees_of_freedom", model.n_dofs}};
+}
+
+nlohmann::json evaluation_summary(const Study& study, const Model& model, const Evaluation& ev) {
+  nlohmann::json s;
+  s["study"] = study.name;
+  s["file"] = study.file;
+  s["beamrail_version"] = kVersion;
+  s["status"] = ev.status;
+  s["message"] = ev.message;
+  nlohmann::json responses = nlohmann::json::object();
+  for (size_t k = 0; k < study.responses.size(); ++k)
+    responses[study.responses[k].name] = json_number(ev.responses[k]);
+  s["responses"] = responses;
+  s["model"] = model_summary(model);
+  nlohmann::json analyses = nlohmann::json::array();
+  for (const AnalysisReport& a : ev.analyses) {
+    nlohmann::json j{{"type", a.type},
+                     {"status", a.ok ? "ok" : "failed"},
+                     {"message", a.message},
+                     {"wall_seconds", a.stats.wall_seconds},
+                     {"steps", a.stats.steps},
+                     {"rhs_evaluations", a.stats.rhs_evaluations},
+                     {"jacobian_evaluations", a.stats.jacobian_evaluations},
+                     {"nonlinear_iterations", a.stats.nonlinear_iterations},
+                     {"nonlinear_failures", a.stats.nonlinear_failures},
+                     {"error_test_failures", a.stats.error_test_failures}};
+    if (a.type == "transient") {
+      j["t_reached"] = a.t_end;
+      j["energy_initial"] = json_number(a.energy_initial);
+      j["energy_final"] = json_number(a.energy_final);
+      j["energy_max_relative_change"] = json_number(a.energy_max_relative_change);
+    }
+    analyses.push_back(j);
+  }
+  s["analyses"] = analyses;
+  s["wall_seconds"] = ev.wall_seconds;
+  s["warnings"] = ev.warnings;
+  return s;
+}
+
+}  // namespace beamrail

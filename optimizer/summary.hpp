@@ -1,0 +1,21 @@
+// summary.json (SPEC.md "Outputs"): what was modelled, what each analysis cost, the responses,
+// the status and the warnings of a run.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "optimizer/evaluation.hpp"
+#include "optimizer/study.hpp"
+
+namespace beamrail {
+
+// Counts of what the model holds.
+nlohmann::json model_summary(const Model& model);
+
+// The summary of a single evaluation of a study.
+nlohmann::json evaluation_summary(const Study& study, const Model& model, const Evaluation& ev);
+
+// A number for JSON output: null when not finite.
+nlohmann::json json_number(double x);
+
+}  // namespace beamrail

@@ -10,6 +10,11 @@
 // where T (3 x 3) is the derivative of the three angles with respect to a small rotation of the
 // right end expressed in the left-end frame. A force law given as a gradient g = dU/d(xi, phi) thus
 // yields the generalized forces -dU/d(c, theta) of both bodies (apply_deformation_gradient).
+//
+// The paper's phi_y comes from the third column of A, so a large twist about the element axis
+// leaks into it. An element that must let the right end turn freely about its axis (a cylindrical
+// rail) takes both bending angles from the first column instead, the direction of the right end's
+// axis: phi_y = atan2(-a31, a11), phi_z = atan2(a21, a11). Both definitions agree to first order.
 #pragma once
 
 #include <cmath>
@@ -40,7 +45,8 @@ struct ElementFrames {
 };
 
 template <class T>
-ElementFrames<T> element_frames(const ElementEnds& ends, const Pose<T>& b1, const Pose<T>& b2) {
+ElementFrames<T> element_frames(const ElementEnds& ends, const Pose<T>& b1, const Pose<T>& b2,
+                                bool twist_free_bending = false) {
   using std::atan2;
   ElementFrames<T> f;
   f.E1 = b1.A * ends.frame1.cast<T>();
@@ -59,6 +65,11 @@ ElementFrames<T> element_frames(const ElementEnds& ends, const Pose<T>& b1, cons
   f.t << T(1), -a(0, 1) * a(1, 1) / nx, -a(0, 1) * a(2, 1) / nx,  //
       -a(0, 2) * a(1, 2) / ny, T(1), -a(1, 2) * a(2, 2) / ny,     //
       -a(0, 0) * a(2, 0) / nz, -a(1, 0) * a(2, 0) / nz, T(1);
+  if (twist_free_bending) {
+    const T n = a(0, 0) * a(0, 0) + a(2, 0) * a(2, 0);
+    f.phi(1) = atan2(-a(2, 0), a(0, 0));
+    f.t.row(1) << -a(0, 0) * a(1, 0) / n, T(1), -a(1, 0) * a(2, 0) / n;
+  }
   return f;
 }
 

@@ -37,7 +37,8 @@ Vec6T<T> rail_deformation(const ElementFrames<T>& f) {
 template <class T>
 T rail_wrenches(const Rail& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
                 bool* floored) {
-  const ElementFrames<T> f = element_frames(rail.ends, b1, b2);
+  const ElementFrames<T> f =
+      element_frames(rail.ends, b1, b2, rail.type == RailType::kCylindrical);
   const T l = rail_length(rail, f, floored);
   const StiffnessBlocks<T> k(0.0, rail.gj, rail.eiy, rail.eiz, l);
   const Vec6T<T> d = rail_deformation(f);

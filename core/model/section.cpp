@@ -9,13 +9,17 @@ namespace beamrail {
 double rectangle_torsion_constant(double a, double b) {
   if (a < b) std::swap(a, b);
   constexpr double pi = std::numbers::pi;
-  double sum = 0.0;
-  for (int n = 1; n < 200; n += 2) {
-    const double term = std::tanh(n * pi * a / (2.0 * b)) / std::pow(n, 5);
-    sum += term;
-    if (term < 1e-18 * sum) break;
+  // sum_{n odd} tanh(x_n) / n^5 = (31/32) zeta(5) - sum_{n odd} (1 - tanh(x_n)) / n^5; the second
+  // sum falls off like exp(-n pi a / b), so a few terms give full precision.
+  constexpr double odd_zeta5 = 31.0 / 32.0 * 1.0369277551433699263;
+  double tail = 0.0;
+  for (int n = 1; n < 60; n += 2) {
+    const double x = n * pi * a / (2.0 * b);
+    const double term = 2.0 / (std::exp(2.0 * x) + 1.0) / std::pow(n, 5);  // 1 - tanh(x)
+    tail += term;
+    if (term < 1e-20) break;
   }
-  return a * b * b * b / 3.0 * (1.0 - 192.0 / std::pow(pi, 5) * (b / a) * sum);
+  return a * b * b * b / 3.0 * (1.0 - 192.0 / std::pow(pi, 5) * (b / a) * (odd_zeta5 - tail));
 }
 
 SectionProperties rectangle_section(double width, double height) {

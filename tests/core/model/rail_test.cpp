@@ -63,7 +63,11 @@ RailCase random_case(Random& rng, RailType type, Formulation formulation, double
   return s;
 }
 
-ElementFrames<double> frames(const RailCase& s) { return element_frames(s.rail.ends, s.b1, s.b2); }
+// The frames as the kernel measures them (cylindrical rails: twist-free bending angles).
+ElementFrames<double> frames(const Rail& rail, const Pose<double>& b1, const Pose<double>& b2) {
+  return element_frames(rail.ends, b1, b2, rail.type == RailType::kCylindrical);
+}
+ElementFrames<double> frames(const RailCase& s) { return frames(s.rail, s.b1, s.b2); }
 
 // Slides the carriage along the rail (the x axis of the left-end frame) until xi_x = length.
 void slide_to(RailCase& s, double length) {
@@ -228,7 +232,7 @@ TEST(Rail, ForcesEqualStiffnessTimesDeformationWhenSmall) {
       Vec6 imposed;
       imposed.head<3>() = fr0.E1.transpose() * (dc + theta.cross(fr0.R2));
       imposed.tail<3>() = fr0.E1.transpose() * theta;
-      const ElementFrames<double> fr = element_frames(s.rail.ends, s.b1, b2);
+      const ElementFrames<double> fr = frames(s.rail, s.b1, b2);
       const Vec6 delta = rail_deformation(fr);
       // delta(0) is zero by definition; the axial motion changes l instead.
       worst_delta =
@@ -246,7 +250,7 @@ TEST(Rail, ForcesEqualStiffnessTimesDeformationWhenSmall) {
         // Second order: doubling the deformation quadruples it.
         const Wrenches w2x = evaluate(s.rail, s.b1, testing::perturbed(s.b2, 2 * dc, 2 * theta));
         const ElementFrames<double> fr2 =
-            element_frames(s.rail.ends, s.b1, testing::perturbed(s.b2, 2 * dc, 2 * theta));
+            frames(s.rail, s.b1, testing::perturbed(s.b2, 2 * dc, 2 * theta));
         Vec6 q1, q2;
         end_vectors(fr2, w2x, q1, q2);
         worst_order = std::max(worst_order, std::abs(q2(0) / p2(0) - 4.0));
@@ -308,11 +312,10 @@ TEST(Rail, CylindricalRailTransmitsNoTorsion) {
   }
 }
 
-// KNOWN FAILURE, see the report: phi_y = atan2(a13, a33) jumps to +-pi once the carriage has
-// turned more than 90 degrees about the rail (a33 = cos alpha < 0, a13 = 0), and the angle
-// derivative T divides by a33^2 + a13^2 = 0 at exactly 90 degrees. A cylindrical rail, whose
-// carriage is meant to turn freely, then exerts a bending moment of order 4 EI pi / l.
-TEST(Rail, DISABLED_CylindricalRailCarriageTurnsFreelyThroughAFullTurn) {
+// The carriage of a cylindrical rail turns freely about the rail through a whole turn. (The
+// paper's phi_y = atan2(a13, a33) would jump to +-pi past 90 degrees; cylindrical rails take both
+// bending angles from the carriage's axis direction, which a turn about the rail leaves alone.)
+TEST(Rail, CylindricalRailCarriageTurnsFreelyThroughAFullTurn) {
   for (Formulation f : kBoth) {
     Random rng(24);
     double worst = 0;
@@ -334,12 +337,10 @@ TEST(Rail, DISABLED_CylindricalRailCarriageTurnsFreelyThroughAFullTurn) {
   }
 }
 
-// KNOWN FAILURE, see the report: the bending reaction of a cylindrical rail should not depend on
-// how far the carriage has turned about its own bore axis (a motion the rail leaves free), but the
-// kernel measures bending with the angles phi_y, phi_z of the full relative rotation, which mix
-// the free turn into the bending: a bend beta about the rail's z with the carriage turned by alpha
-// reads phi_y = atan(sin beta tan alpha).
-TEST(Rail, DISABLED_CylindricalRailBendingIsIndependentOfTheCarriageTurn) {
+// The bending reaction of a cylindrical rail does not depend on how far the carriage has turned
+// about its own bore axis (a motion the rail leaves free). With the paper's angles a bend beta
+// about the rail's z with the carriage turned by alpha would read phi_y = atan(sin beta tan alpha).
+TEST(Rail, CylindricalRailBendingIsIndependentOfTheCarriageTurn) {
   for (Formulation f : kBoth) {
     Random rng(25);
     double worst = 0;

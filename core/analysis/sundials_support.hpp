@@ -55,8 +55,7 @@ struct LinearSolverOwner {
 // Collects the last error SUNDIALS reported (install with CVodeSetErrHandlerFn and friends).
 struct SundialsMessages {
   std::string last;
-  static void handler(int code, const char* module, const char* function, char* msg,
-                      void* self) {
+  static void handler(int code, const char* module, const char* function, char* msg, void* self) {
     auto* m = static_cast<SundialsMessages*>(self);
     m->last = std::string(module ? module : "") + " " + (function ? function : "") + " (" +
               std::to_string(code) + "): " + (msg ? msg : "");

@@ -109,7 +109,8 @@ std::vector<double> load_breakpoints(const Model& model, double t_end) {
 }
 
 std::string cvode_failure(int flag, const SundialsMessages& messages, const OdeContext& context) {
-  if (!context.callback_error.empty()) return "error while evaluating the model: " + context.callback_error;
+  if (!context.callback_error.empty())
+    return "error while evaluating the model: " + context.callback_error;
   std::string why;
   switch (flag) {
     case CV_TOO_MUCH_WORK:
@@ -180,7 +181,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
 
     const std::vector<double> breakpoints = load_breakpoints(model, options.t_end);
     size_t next_break = 0;
-    const long n_out = std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
+    const long n_out =
+        std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
     double t = 0.0;
     result.ok = true;
     for (long k = 1; k <= n_out && result.ok; ++k) {

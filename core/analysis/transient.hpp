@@ -18,19 +18,19 @@ enum class LinearSolverKind { kAuto, kDense, kSparse };
 
 struct IntegratorOptions {
   std::string method = "bdf";
-  double rtol = 1e-6;   // relative tolerance
-  double atol = 1e-9;   // absolute tolerance (states in m, -, m/s, rad/s)
+  double rtol = 1e-6;  // relative tolerance
+  double atol = 1e-9;  // absolute tolerance (states in m, -, m/s, rad/s)
   JacobianKind jacobian = JacobianKind::kExact;
   LinearSolverKind linear_solver = LinearSolverKind::kAuto;
-  int max_order = 5;            // BDF order limit, 1..5
-  double max_step = 0.0;        // [s]; 0: no limit
-  double initial_step = 0.0;    // [s]; 0: the integrator's estimate
-  long max_steps = 10000000;    // total step budget over the run
+  int max_order = 5;          // BDF order limit, 1..5
+  double max_step = 0.0;      // [s]; 0: no limit
+  double initial_step = 0.0;  // [s]; 0: the integrator's estimate
+  long max_steps = 10000000;  // total step budget over the run
 };
 
 struct TransientOptions {
-  double t_end = 1.0;        // [s]
-  double output_step = 0.01; // [s]
+  double t_end = 1.0;         // [s]
+  double output_step = 0.01;  // [s]
   IntegratorOptions integrator;
 };
 
@@ -44,7 +44,7 @@ struct TransientSample {
 struct SolverStats {
   double wall_seconds = 0.0;
   long steps = 0;
-  long rhs_evaluations = 0;       // including those for finite-difference Jacobians
+  long rhs_evaluations = 0;  // including those for finite-difference Jacobians
   long jacobian_evaluations = 0;
   long nonlinear_iterations = 0;
   long nonlinear_failures = 0;

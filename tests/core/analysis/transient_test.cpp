@@ -1,0 +1,173 @@
+// Transient analysis against closed forms and conservation laws (DESIGN.md §4).
+#include "core/analysis/transient.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <numbers>
+#include <string>
+
+#include "tests/support/transient_run.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::Snapshot;
+using testing::TransientRun;
+constexpr double kPi = std::numbers::pi;
+
+// Steel, 1 m, 10 mm square section (the paper's kind of test piece).
+constexpr double kE = 2.1e11, kG = 8.0769e10, kL = 1.0, kSide = 0.01;
+const double kArea = kSide * kSide;
+const double kI = std::pow(kSide, 4) / 12.0;
+
+// Cantilever from ground to a tip body at (1, 0, 0); the body's JSON fields are spliced in.
+std::string cantilever(const std::string& tip_fields, const std::string& beam_fields = "") {
+  return R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "tip", "position": [1, 0, 0], )" +
+         tip_fields + R"(}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq" )" +
+         beam_fields + "}]}";
+}
+
+// Mean spacing of the upward zero crossings of signal(snapshot), by linear interpolation.
+double period(const TransientRun& run, const std::function<double(const Snapshot&)>& signal) {
+  std::vector<double> crossings;
+  for (size_t k = 1; k < run.samples.size(); ++k) {
+    const double a = signal(run.samples[k - 1]), b = signal(run.samples[k]);
+    if (a < 0.0 && b >= 0.0) {
+      const double ta = run.samples[k - 1].sample.t, tb = run.samples[k].sample.t;
+      crossings.push_back(ta + (tb - ta) * a / (a - b));
+    }
+  }
+  if (crossings.size() < 2) return 0.0;
+  return (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+}
+
+TEST(Transient, BendingPeriodOfTipBodyMatchesClosedForm) {
+  // Tip mass 1 kg with negligible rotary inertia (1e-8 kg m^2). The tip starts on the slow mode
+  // of the 2 x 2 problem [12 -6l; -6l 4l^2] EI/l^3 x = w^2 diag(m, J) x, turning at theta/y of its
+  // lateral velocity, so the fast rotary mode (2.6e5 rad/s) stays at rest.
+  const double m = 1.0, j = 1e-8, ei = kE * kI;
+  const double b = 4 * ei + 12 * ei * j, w2 = (b - std::sqrt(b * b - 48 * ei * ei * j)) / (2 * j);
+  const double ratio = (12 * ei - w2 * m) / (6 * ei);
+  char fields[256];
+  std::snprintf(fields, sizeof fields,
+                R"("mass": 1.0, "inertia": [1e-8, 1e-8, 1e-8], "velocity": [0, 1e-3, 0],
+                   "angular_velocity": [0, 0, %.17g])",
+                ratio * 1e-3);
+  const Model model = testing::scene_from_json(cantilever(fields));
+  const double exact = 2 * kPi * std::sqrt(m * std::pow(kL, 3) / (3 * ei));
+  // BDF orders 3-5 are unstable near the imaginary axis: with the undamped rotary mode at
+  // 2.6e5 rad/s they are held to steps of ~1e-6 s (2.9e6 steps here); A-stable BDF2 is not.
+  TransientOptions o = testing::options(20 * exact, exact / 2000, 1e-10, 1e-14);
+  o.integrator.max_order = 2;
+  const TransientRun run = testing::simulate(model, o);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double measured = period(run, [](const Snapshot& s) { return s.pose[1].c(1); });
+  std::printf(
+      "bending period: measured %.12f s, closed form %.12f s, relative error %.2e (%ld steps)\n",
+      measured, exact, measured / exact - 1, run.result.stats.steps);
+  EXPECT_NEAR(measured / exact, 1.0, 1e-6);
+}
+
+TEST(Transient, AxialPeriodOfTipBodyMatchesClosedForm) {
+  const Model model = testing::scene_from_json(
+      cantilever(R"("mass": 2.0, "inertia": [1e-4, 1e-4, 1e-4], "velocity": [1e-3, 0, 0])"));
+  const double exact = 2 * kPi * std::sqrt(2.0 * kL / (kE * kArea));
+  const TransientRun run =
+      testing::simulate(model, testing::options(20 * exact, exact / 2000, 1e-11, 1e-15));
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double measured = period(run, [](const Snapshot& s) { return s.pose[1].c(0) - 1.0; });
+  std::printf("axial period: measured %.12f s, closed form %.12f s, relative error %.2e\n",
+              measured, exact, measured / exact - 1);
+  EXPECT_NEAR(measured / exact, 1.0, 1e-6);
+}
+
+TEST(Transient, TorsionalPeriodOfTipBodyMatchesClosedForm) {
+  const double jx = 2e-3;
+  const Model model = testing::scene_from_json(cantilever(
+      R"("mass": 1.0, "inertia": [2e-3, 1e-3, 1e-3], "angular_velocity": [1e-3, 0, 0])"));
+  const double ix = model.beams[0].gj / kG;
+  const double exact = 2 * kPi * std::sqrt(kL * jx / (kG * ix));
+  const TransientRun run =
+      testing::simulate(model, testing::options(20 * exact, exact / 2000, 1e-11, 1e-15));
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  // Twist angle about x: 2 q1 q0 ~ angle for small angles; the sign is what matters.
+  const double measured = period(run, [](const Snapshot& s) { return s.q[1](1) * s.q[1](0); });
+  std::printf("torsional period: measured %.12f s, closed form %.12f s, relative error %.2e\n",
+              measured, exact, measured / exact - 1);
+  EXPECT_NEAR(measured / exact, 1.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace beamrail
+
+namespace beamrail {
+namespace {
+
+// theta / u of the slow bending mode of a tip body (mass m, rotary inertia j) on a cantilever:
+// the smaller root of j w^4 - (4 + 12 j / (m l^2)) EI w^2 / l ... for l = 1, from the 2 x 2
+// problem.
+double slow_mode_ratio(double m, double j, double ei) {
+  const double b = 4 * ei * m + 12 * ei * j;
+  const double w2 = (b - std::sqrt(b * b - 48 * ei * ei * j * m)) / (2 * j * m);
+  return (12 * ei - w2 * m) / (6 * ei);
+}
+
+// A tip body vibrating at small amplitude in both bending planes (slow modes) and in torsion.
+std::string vibrating_tip() {
+  const double ei = kE * kI, vy = 1e-3, vz = -8e-4;
+  char fields[320];
+  std::snprintf(fields, sizeof fields,
+                R"("mass": 1.0, "inertia": [2e-3, 1e-3, 1.5e-3], "velocity": [0, %.17g, %.17g],
+                   "angular_velocity": [0.02, %.17g, %.17g])",
+                vy, vz, -slow_mode_ratio(1.0, 1e-3, ei) * vz,
+                slow_mode_ratio(1.0, 1.5e-3, ei) * vy);
+  return fields;
+}
+
+TEST(Transient, UndampedFreeVibrationKeepsTotalEnergy) {
+  const Model model = testing::scene_from_json(cantilever(vibrating_tip()));
+  const double slow = 2 * kPi * std::sqrt(1.0 * std::pow(kL, 3) / (3 * kE * kI));
+  // BDF damps an oscillation by ~C (h w)^(q+1) per step whatever the tolerance, so over 500
+  // torsion periods the step size, not rtol, sets the drift (1.0e-6 at rtol 1e-12 with free
+  // steps; 8.6e-8 with steps <= 5e-5 s).
+  TransientOptions o = testing::options(50 * slow, slow / 20, 1e-12, 1e-14);
+  o.integrator.max_step = 5e-5;
+  const TransientRun run = testing::simulate(model, o);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double e0 = run.samples.front().sample.energy();
+  double worst = 0;
+  for (const Snapshot& s : run.samples)
+    worst = std::max(worst, std::abs(s.sample.energy() / e0 - 1));
+  std::printf(
+      "undamped vibration (bending in y and z, torsion), 50 periods: max |E/E0 - 1| = %.2e "
+      "(%ld steps)\n",
+      worst, run.result.stats.steps);
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(Transient, DampingNeverIncreasesTotalEnergy) {
+  const Model model = testing::scene_from_json(cantilever(vibrating_tip(), R"(, "damping": 2e-4)"));
+  const TransientRun run = testing::simulate(model, testing::options(2.0, 1e-3, 1e-10, 1e-14));
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double e0 = run.samples.front().sample.energy();
+  double largest_rise = -1;
+  for (size_t k = 1; k < run.samples.size(); ++k)
+    largest_rise = std::max(
+        largest_rise, (run.samples[k].sample.energy() - run.samples[k - 1].sample.energy()) / e0);
+  const double lost = 1 - run.samples.back().sample.energy() / e0;
+  std::printf("damped vibration: largest rise between samples %.2e E0, lost %.4f of E0 in 2 s\n",
+              largest_rise, lost);
+  EXPECT_LE(largest_rise, 0.0);
+  EXPECT_GT(lost, 0.1);  // the damping does act
+}
+
+}  // namespace
+}  // namespace beamrail

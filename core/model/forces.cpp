@@ -7,14 +7,11 @@
 namespace beamrail {
 namespace {
 
-void add_loads(const Model& model, Data& data, double t) {
-  for (const Body& b : model.bodies) {
-    if (b.fixed) continue;
-    const int i = static_cast<int>(&b - model.bodies.data());
-    data.wrench[i].head<3>() += b.mass * model.gravity;
-  }
+void add_loads(const Model& model, Data& data, double t, double load_factor) {
+  for (int i : model.free_bodies)
+    data.wrench[i].head<3>() += load_factor * model.bodies[i].mass * model.gravity;
   for (const Load& load : model.loads) {
-    const Vec3 value = load.time(t) * load.value;
+    const Vec3 value = load_factor * load.time(t) * load.value;
     Vec6& w = data.wrench[load.body];
     if (load.kind == LoadKind::kForce) {
       const Vec3 lever = data.pose[load.body].A * load.offset;
@@ -37,9 +34,9 @@ void scatter(const std::array<int, 4>& blocks, const Mat12& j, std::vector<Mat6>
 
 }  // namespace
 
-void compute_wrenches(const Model& model, Data& data, double t) {
+void compute_wrenches(const Model& model, Data& data, double t, double load_factor) {
   for (Vec6& w : data.wrench) w.setZero();
-  add_loads(model, data, t);
+  add_loads(model, data, t, load_factor);
   double energy = 0.0;
   for (const Beam& e : model.beams) {
     const int i1 = e.ends.body1, i2 = e.ends.body2;
@@ -49,8 +46,8 @@ void compute_wrenches(const Model& model, Data& data, double t) {
     const Rail& e = model.rails[r];
     const int i1 = e.ends.body1, i2 = e.ends.body2;
     bool floored = false;
-    energy += rail_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2],
-                            &floored);
+    energy +=
+        rail_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2], &floored);
     data.rail_floored[r] = floored;
     if (floored) data.rail_floored_ever[r] = 1;
   }
@@ -58,7 +55,8 @@ void compute_wrenches(const Model& model, Data& data, double t) {
   ++data.n_wrench_evaluations;
 }
 
-void compute_tangent(const Model& model, Data& data, double t, bool with_velocity) {
+void compute_tangent(const Model& model, Data& data, double t, bool with_velocity,
+                     double load_factor) {
   for (Mat6& k : data.stiffness) k.setZero();
   if (with_velocity)
     for (Mat6& c : data.damping) c.setZero();
@@ -67,7 +65,7 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
   for (const Load& load : model.loads) {
     const int k = model.bodies[load.body].free_index;
     if (k < 0 || load.kind != LoadKind::kForce) continue;
-    const Vec3 value = load.time(t) * load.value;
+    const Vec3 value = load_factor * load.time(t) * load.value;
     const Vec3 lever = data.pose[load.body].A * load.offset;
     data.stiffness[k].block<3, 3>(3, 3) += skew<double>(value) * skew<double>(lever);
   }

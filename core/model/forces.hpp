@@ -7,13 +7,15 @@
 
 namespace beamrail {
 
-// Sets data.wrench (every body; global force and moment about the centre of mass), data.elastic_energy
-// and data.rail_floored at time t [s] from data.pose.
-void compute_wrenches(const Model& model, Data& data, double t);
+// Sets data.wrench (every body; global force and moment about the centre of mass),
+// data.elastic_energy and data.rail_floored at time t [s] from data.pose. Gravity and loads are
+// scaled by load_factor (static load stepping); t = +infinity gives every load its final value.
+void compute_wrenches(const Model& model, Data& data, double t, double load_factor = 1.0);
 
 // Sets data.stiffness (and data.damping when with_velocity) for every block of model.pattern at
 // time t from data.pose; the velocity blocks are exact for any scene, zero without damping.
-void compute_tangent(const Model& model, Data& data, double t, bool with_velocity);
+void compute_tangent(const Model& model, Data& data, double t, bool with_velocity,
+                     double load_factor = 1.0);
 
 // Kinetic energy of all free bodies [J].
 double kinetic_energy(const Model& model, const Data& data);

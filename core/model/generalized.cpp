@@ -1,0 +1,66 @@
+#include "core/model/generalized.hpp"
+
+#include "core/model/rotation.hpp"
+
+namespace beamrail {
+
+Eigen::VectorXd wrench_vector(const Model& model, const Data& data) {
+  Eigen::VectorXd w(model.n_dofs);
+  for (int k = 0; k < model.n_free(); ++k)
+    w.segment<kDofsPerBody>(kDofsPerBody * k) = data.wrench[model.free_bodies[k]];
+  return w;
+}
+
+Eigen::SparseMatrix<double> stiffness_matrix(const Model& model, const Data& data) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(36 * model.pattern.blocks.size());
+  for (size_t b = 0; b < model.pattern.blocks.size(); ++b) {
+    const int r0 = kDofsPerBody * model.pattern.blocks[b].row;
+    const int c0 = kDofsPerBody * model.pattern.blocks[b].col;
+    for (int c = 0; c < 6; ++c)
+      for (int r = 0; r < 6; ++r) entries.emplace_back(r0 + r, c0 + c, data.stiffness[b](r, c));
+  }
+  Eigen::SparseMatrix<double> k(model.n_dofs, model.n_dofs);
+  k.setFromTriplets(entries.begin(), entries.end());
+  return k;
+}
+
+Eigen::SparseMatrix<double> mass_matrix(const Model& model, const Data& data) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int k = 0; k < model.n_free(); ++k) {
+    const int i = model.free_bodies[k];
+    const Body& b = model.bodies[i];
+    const Mat3 j = data.pose[i].A * b.inertia * data.pose[i].A.transpose();
+    const int o = kDofsPerBody * k;
+    for (int r = 0; r < 3; ++r) {
+      entries.emplace_back(o + r, o + r, b.mass);
+      for (int c = 0; c < 3; ++c) entries.emplace_back(o + 3 + r, o + 3 + c, j(r, c));
+    }
+  }
+  Eigen::SparseMatrix<double> m(model.n_dofs, model.n_dofs);
+  m.setFromTriplets(entries.begin(), entries.end());
+  return m;
+}
+
+void apply_increment(const Model& model, Data& data, const Eigen::VectorXd& dx) {
+  for (int k = 0; k < model.n_free(); ++k) {
+    const int i = model.free_bodies[k];
+    const Vec3 dc = dx.segment<3>(kDofsPerBody * k);
+    const Vec3 dtheta = dx.segment<3>(kDofsPerBody * k + 3);
+    data.pose[i].c += dc;
+    data.q[i] = quat_multiply(quat_from_rotation_vector(dtheta), data.q[i]);
+    data.q[i] /= data.q[i].norm();
+    data.pose[i].A = rotation_matrix<double>(data.q[i]);
+  }
+}
+
+void reset_to_initial(const Model& model, Data& data) {
+  for (int i : model.free_bodies) {
+    const Body& b = model.bodies[i];
+    data.q[i] = b.orientation / b.orientation.norm();
+    data.w[i].setZero();
+    data.pose[i] = {b.position, rotation_matrix<double>(data.q[i]), Vec3::Zero(), Vec3::Zero()};
+  }
+}
+
+}  // namespace beamrail

@@ -1,0 +1,29 @@
+// Generalized coordinates of the static and modal analyses: 6 per free body, the displacement of
+// the centre of mass dc and a rotation increment dtheta (global axes, A -> exp([dtheta]x) A), in
+// free-body order (dim model.n_dofs).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "core/model/data.hpp"
+#include "core/model/model.hpp"
+
+namespace beamrail {
+
+// The wrenches of the free bodies (force, moment about the centre; global), dim n_dofs.
+Eigen::VectorXd wrench_vector(const Model& model, const Data& data);
+
+// d wrench / d (dc, dtheta) assembled from data.stiffness (n_dofs x n_dofs).
+Eigen::SparseMatrix<double> stiffness_matrix(const Model& model, const Data& data);
+
+// The mass matrix in these coordinates: blocks m I and A J A^T (n_dofs x n_dofs).
+Eigen::SparseMatrix<double> mass_matrix(const Model& model, const Data& data);
+
+// Moves the free bodies by dx: c += dc, q <- quat(dtheta) (x) q; updates pose (at rest).
+void apply_increment(const Model& model, Data& data, const Eigen::VectorXd& dx);
+
+// Resets every free body to its initial pose, at rest.
+void reset_to_initial(const Model& model, Data& data);
+
+}  // namespace beamrail

@@ -1,11 +1,14 @@
 #include "optimizer/study.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/scene/scene_loader.hpp"
 
 namespace beamrail {
 namespace {
+
+const std::vector<std::string> kAnalysisTypes = {"transient"};
 
 void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
                      IntegratorOptions& io) {
@@ -35,8 +38,11 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   if (!r.is_object()) return std::nullopt;
   AnalysisSpec a;
   a.where = where;
-  const auto type = r.choice("type", true, {"transient"});
-  if (!type) return std::nullopt;
+  const auto type = r.choice("type", true, kAnalysisTypes);
+  if (!type) {
+    r.allow({"t_end", "output_step", "integrator"});
+    return std::nullopt;
+  }
   const auto t_end = r.positive("t_end", true);
   const auto step = r.positive("output_step", false);
   if (const Json* i = r.member("integrator", false))
@@ -55,34 +61,56 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   return a;
 }
 
-std::optional<int> body_named(ObjectReader& r, const std::string& key, const Model& model) {
+// Whether the study's list of analyses certainly has none of this type. A missing or malformed
+// list, or an entry whose type is missing or wrong, was reported already: then a response that
+// needs the analysis does not add a second message.
+bool lacks_analysis(const Json& document, const std::string& type) {
+  const auto list = document.find("analyses");
+  if (list == document.end() || !list->is_array() || list->empty()) return false;
+  for (const Json& a : *list) {
+    if (!a.is_object()) return false;
+    const auto t = a.find("type");
+    if (t == a.end() || !t->is_string()) return false;
+    const std::string name = t->get<std::string>();
+    if (name == type) return false;
+    if (std::find(kAnalysisTypes.begin(), kAnalysisTypes.end(), name) == kAnalysisTypes.end())
+      return false;
+  }
+  return true;
+}
+
+// The index of a named body; without a model (the scene has errors) only the name is checked.
+std::optional<int> body_named(ObjectReader& r, const std::string& key, const Model* model) {
   const auto name = r.string(key, true);
-  if (!name) return std::nullopt;
-  for (size_t i = 0; i < model.bodies.size(); ++i)
-    if (model.bodies[i].name == *name && !model.bodies[i].generated) return static_cast<int>(i);
+  if (!name || !model) return std::nullopt;
+  for (size_t i = 0; i < model->bodies.size(); ++i)
+    if (model->bodies[i].name == *name && !model->bodies[i].generated) return static_cast<int>(i);
   r.error(key, "unknown body \"" + *name + "\"");
   return std::nullopt;
 }
 
 std::optional<ResponseSpec> read_response(const std::string& name, const Json& value,
                                           const Where& where, const Study& study,
-                                          Diagnostics& diag) {
+                                          const Model* model, Diagnostics& diag) {
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return std::nullopt;
   ResponseSpec s;
   s.name = name;
   s.where = where;
   const auto q = r.choice("quantity", true, {"peak_displacement", "mass"});
-  if (!q) return std::nullopt;
+  if (!q) {
+    r.allow({"body", "point", "direction"});
+    return std::nullopt;
+  }
   if (*q == "mass") {
     s.quantity = ResponseSpec::Quantity::kMass;
     return s;
   }
   s.quantity = ResponseSpec::Quantity::kPeakDisplacement;
-  const auto body = body_named(r, "body", study.model);
+  const auto body = body_named(r, "body", model);
   const auto point = r.vec3("point", false);
   const auto direction = r.vec3("direction", true);
-  if (find_analysis(study, AnalysisSpec::Type::kTransient) < 0)
+  if (lacks_analysis(study.document, "transient"))
     r.error("quantity", "\"peak_displacement\" needs a transient analysis in \"analyses\"");
   if (direction && !(direction->norm() > 0.0)) {
     r.error("direction", "must not be the zero vector");
@@ -90,7 +118,7 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
   }
   if (!body || !direction) return std::nullopt;
   s.body = *body;
-  s.point = point.value_or(study.model.bodies[*body].position);
+  s.point = point.value_or(model->bodies[*body].position);
   s.direction = direction->normalized();
   return s;
 }
@@ -128,13 +156,17 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
     // The scene: inline, or a path relative to the study file.
     if (const Json* scene = r.member("scene", true)) {
       if (scene->is_string()) {
+        // Named in messages as the user can open it from here: relative to the study's folder.
         const std::filesystem::path p = directory / scene->get<std::string>();
-        const std::string shown = scene->get<std::string>();
-        if (const auto j = read_json_file(p.string(), shown, diag)) {
+        const std::string shown = p.lexically_normal().string();
+        std::error_code ec;
+        if (scene->get<std::string>().empty()) {
+          r.error("scene", "expected the path of a scene file or a scene object, got \"\"");
+        } else if (!std::filesystem::exists(p, ec)) {
+          r.error("scene", "scene file \"" + shown + "\" not found");
+        } else if (const auto j = read_json_file(p.string(), shown, diag)) {
           model = load_scene(*j, {shown, ""}, diag);
           study.document["scene"] = *j;
-        } else {
-          r.error("scene", "cannot load the scene file \"" + shown + "\"");
         }
       } else {
         model = load_scene(*scene, root / "scene", diag);
@@ -155,10 +187,12 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
     if (const Json* responses = r.member("responses", false)) {
       if (!responses->is_object()) {
         r.error("responses", "expected an object of named responses");
-      } else if (model) {
+      } else {
+        // Checked even when the scene has errors (body names then go unchecked).
+        const Model* m = model ? &study.model : nullptr;
         for (const auto& item : responses->items())
           if (auto s = read_response(item.key(), item.value(), root / "responses" / item.key(),
-                                     study, diag))
+                                     study, m, diag))
             study.responses.push_back(*s);
       }
     }
@@ -171,10 +205,15 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
 }
 
 std::optional<Study> load_study_file(const std::string& path, Diagnostics& diag) {
+  const size_t errors_before = diag.size();
   const auto document = read_json_file(path, path, diag);
   if (!document) return std::nullopt;
   std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  return load_study(*document, path, dir, diag);
+  // The document is checked even after duplicate keys were reported, so that all problems are
+  // listed; it is still rejected.
+  auto study = load_study(*document, path, dir, diag);
+  if (diag.size() > errors_before) return std::nullopt;
+  return study;
 }
 
 }  // namespace beamrail

@@ -1,7 +1,12 @@
 #include "core/scene/json_reader.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -18,6 +23,17 @@ size_t edit_distance(const std::string& a, const std::string& b) {
     std::swap(prev, cur);
   }
   return prev[b.size()];
+}
+
+// The shortest text that reads back as x ("-8.1e+10", not "-81000000000" or
+// "-1.0000000000000001e-09").
+std::string shortest(double x) {
+  char buf[32];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
 }
 
 }  // namespace
@@ -67,6 +83,10 @@ ObjectReader::~ObjectReader() {
   }
 }
 
+void ObjectReader::allow(const std::vector<std::string>& keys) {
+  known_.insert(keys.begin(), keys.end());
+}
+
 void ObjectReader::error(const std::string& key, const std::string& message) {
   diag_.error(where_.file, at(key).pointer, message);
 }
@@ -76,8 +96,7 @@ const Json* ObjectReader::member(const std::string& key, bool required) {
   if (!object_) return nullptr;
   const auto it = object_->find(key);
   if (it == object_->end()) {
-    if (required)
-      diag_.error(where_.file, where_.pointer, "missing required key \"" + key + "\"");
+    if (required) diag_.error(where_.file, where_.pointer, "missing required key \"" + key + "\"");
     return nullptr;
   }
   return &*it;
@@ -111,10 +130,7 @@ std::optional<double> ObjectReader::positive(const std::string& key, bool requir
   const auto x = number(key, required);
   if (!x) return std::nullopt;
   if (allow_zero ? *x < 0.0 : *x <= 0.0) {
-    std::ostringstream s;
-    s.precision(17);
-    s << "must be " << (allow_zero ? ">= 0" : "> 0") << ", got " << *x;
-    error(key, s.str());
+    error(key, std::string("must be ") + (allow_zero ? ">= 0" : "> 0") + ", got " + shortest(*x));
     return std::nullopt;
   }
   return x;
@@ -198,42 +214,206 @@ std::optional<std::string> ObjectReader::choice(const std::string& key, bool req
   return std::nullopt;
 }
 
-std::optional<Json> parse_json(const std::string& text, const std::string& file,
-                               Diagnostics& diag) {
-  try {
-    return Json::parse(text);
-  } catch (const Json::parse_error& e) {
-    // Turn the byte offset into line and column.
-    size_t line = 1, column = 1;
-    for (size_t i = 0; i < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n')
-        ++line, column = 1;
-      else
-        ++column;
+namespace {
+
+// "line L, column C" of the character at byte offset `index` (1-based; past the end: just after
+// the last character).
+std::string text_position(const std::string& text, size_t index) {
+  size_t line = 1, column = 1;
+  for (size_t i = 0; i < index && i < text.size(); ++i) {
+    if (text[i] == '\n')
+      ++line, column = 1;
+    else
+      ++column;
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+// The offset of the bracket that opens nesting level kMaxDepth + 1 (strings skipped).
+size_t too_deep_at(const std::string& text, size_t max_depth) {
+  size_t depth = 0;
+  bool in_string = false, escaped = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return i;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return text.size();
+}
+
+// Builds the document from SAX events, keeping the JSON pointer of the value being read so that
+// problems the plain parser hides or reports without a location get one: duplicate keys in an
+// object (nlohmann keeps the last silently), numbers that overflow a double, nesting too deep to
+// process safely.
+class DocumentBuilder {
+ public:
+  static constexpr size_t kMaxDepth = 256;
+
+  DocumentBuilder(const std::string& text, const std::string& file, Diagnostics& diag)
+      : text_(text), file_(file), diag_(diag) {}
+
+  Json& document() { return root_; }
+
+  bool null() { return put(Json(nullptr)); }
+  bool boolean(bool v) { return put(Json(v)); }
+  bool number_integer(Json::number_integer_t v) { return put(Json(v)); }
+  bool number_unsigned(Json::number_unsigned_t v) { return put(Json(v)); }
+  bool number_float(Json::number_float_t v, const Json::string_t&) { return put(Json(v)); }
+  bool string(Json::string_t& v) { return put(Json(std::move(v))); }
+  bool binary(Json::binary_t& v) { return put(Json(std::move(v))); }
+
+  bool start_object(size_t) { return open(Json::object()); }
+  bool start_array(size_t) { return open(Json::array()); }
+  bool end_object() { return close(); }
+  bool end_array() { return close(); }
+
+  bool key(Json::string_t& k) {
+    Frame& f = frames_.back();
+    f.key = k;
+    if (!f.keys.insert(k).second)
+      diag_.error(file_, pending_pointer(),
+                  "duplicate key \"" + k + "\" (a key may appear only once in an object)");
+    return true;
+  }
+
+  bool parse_error(size_t position, const std::string& last_token, const Json::exception& e) {
+    // `position` counts the characters read, the last one of the offending token included.
+    const size_t index = position > 0 ? position - 1 : 0;
+    if (e.id == 406) {  // a number that overflows a double, e.g. 1e999
+      const size_t start = index + 1 >= last_token.size() ? index + 1 - last_token.size() : 0;
+      diag_.error(file_, pending_pointer(),
+                  "number " + last_token + " is out of range (not a finite double), at " +
+                      text_position(text_, start));
+      return false;
     }
     std::string what = e.what();
     const size_t cut = what.find("syntax error");
     if (cut != std::string::npos) what = what.substr(cut);
-    diag.error(file, "",
-               "invalid JSON at line " + std::to_string(line) + ", column " +
-                   std::to_string(column) + ": " + what);
+    diag_.error(file_, "", "invalid JSON at " + text_position(text_, index) + ": " + what);
+    return false;
+  }
+
+ private:
+  struct Frame {
+    Json* value;
+    std::string key;             // objects: the key of the member being read
+    std::set<std::string> keys;  // objects: the keys seen so far
+  };
+
+  // The pointer of the value about to be read (or of the member whose key was just read).
+  std::string pending_pointer() const {
+    std::string p;
+    for (size_t i = 0; i < frames_.size(); ++i) {
+      const Frame& f = frames_[i];
+      const bool last = i + 1 == frames_.size();
+      p += '/';
+      if (f.value->is_object())
+        p += pointer_token(f.key);
+      else
+        p += std::to_string(f.value->size() - (last ? 0 : 1));
+    }
+    return p;
+  }
+
+  // Stores a value where it belongs; returns its address.
+  Json* place(Json&& v) {
+    if (frames_.empty()) {
+      root_ = std::move(v);
+      return &root_;
+    }
+    Json& parent = *frames_.back().value;
+    if (parent.is_array()) {
+      parent.push_back(std::move(v));
+      return &parent.back();
+    }
+    Json& slot = parent[frames_.back().key];
+    slot = std::move(v);
+    return &slot;
+  }
+
+  bool put(Json&& v) {
+    place(std::move(v));
+    return true;
+  }
+
+  bool open(Json&& container) {
+    if (frames_.size() >= kMaxDepth) {
+      // Not by pointer: it would be hundreds of characters long.
+      diag_.error(file_, "",
+                  "invalid JSON at " + text_position(text_, too_deep_at(text_, kMaxDepth)) +
+                      ": nesting deeper than " + std::to_string(kMaxDepth) + " levels");
+      return false;
+    }
+    frames_.push_back({place(std::move(container)), {}, {}});
+    return true;
+  }
+
+  bool close() {
+    frames_.pop_back();
+    return true;
+  }
+
+  const std::string& text_;
+  const std::string& file_;
+  Diagnostics& diag_;
+  Json root_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace
+
+std::optional<Json> parse_json(const std::string& text, const std::string& file,
+                               Diagnostics& diag) {
+  const size_t errors_before = diag.size();
+  DocumentBuilder builder(text, file, diag);
+  bool ok = false;
+  try {
+    ok = Json::sax_parse(text, &builder, Json::input_format_t::json, /*strict=*/true);
   } catch (const std::exception& e) {
     diag.error(file, "", std::string("invalid JSON: ") + e.what());
+    return std::nullopt;
   }
-  return std::nullopt;
+  if (!ok) {
+    if (diag.size() == errors_before) diag.error(file, "", "invalid JSON");
+    return std::nullopt;
+  }
+  // Duplicate keys were reported; the document is still returned so that the rest of it is
+  // checked too (callers fail when the diagnostics grew).
+  return std::move(builder.document());
 }
 
 std::optional<Json> read_json_file(const std::string& path, const std::string& display_name,
                                    Diagnostics& diag) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    diag.error(display_name, "", "cannot read file: it is a directory");
+    return std::nullopt;
+  }
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    diag.error(display_name, "", "cannot read file");
+    const int err = errno;
+    diag.error(
+        display_name, "",
+        std::string("cannot read file") + (err ? ": " + std::string(std::strerror(err)) : ""));
     return std::nullopt;
   }
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) {
-    diag.error(display_name, "", "cannot read file");
+    diag.error(display_name, "", "cannot read file: read error");
     return std::nullopt;
   }
   return parse_json(text.str(), display_name, diag);

@@ -20,7 +20,9 @@ using Json = nlohmann::json;
 struct Where {
   std::string file;
   std::string pointer;
-  Where operator/(const std::string& key) const { return {file, pointer + "/" + pointer_token(key)}; }
+  Where operator/(const std::string& key) const {
+    return {file, pointer + "/" + pointer_token(key)};
+  }
   Where operator/(size_t index) const { return {file, pointer + "/" + std::to_string(index)}; }
 };
 
@@ -59,6 +61,10 @@ class ObjectReader {
   std::optional<std::string> choice(const std::string& key, bool required,
                                     const std::vector<std::string>& choices);
 
+  // Accepts these keys without reading them: used when a "type" or "shape" is wrong or missing,
+  // so that the members of the other variants are not reported as unknown as well.
+  void allow(const std::vector<std::string>& keys);
+
   void error(const std::string& key, const std::string& message);
 
  private:
@@ -71,7 +77,10 @@ class ObjectReader {
 // Reads a finite number at a location; reports and returns nullopt otherwise.
 std::optional<double> read_number(const Json& value, const Where& where, Diagnostics& diag);
 
-// Parses a JSON document from text; reports syntax errors with line and column.
+// Parses a JSON document from text; reports syntax errors with line and column, numbers that
+// overflow a double, and excessive nesting (then returns nullopt). Duplicate keys in an object are
+// reported with their pointer but the document (last value kept) is still returned so that the
+// rest can be checked: callers must treat new diagnostics as failure, not just nullopt.
 std::optional<Json> parse_json(const std::string& text, const std::string& file, Diagnostics& diag);
 
 // Reads and parses a JSON file; reports unreadable files and syntax errors.

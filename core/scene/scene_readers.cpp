@@ -40,9 +40,12 @@ void for_each_entry(ObjectReader& parent, const std::string& key, F&& f) {
 }
 
 std::optional<SectionProperties> read_section(ObjectReader& r) {
-  const auto shape =
-      r.choice("shape", true, {"rectangle", "circle", "tube", "box", "custom"});
-  if (!shape) return std::nullopt;
+  const auto shape = r.choice("shape", true, {"rectangle", "circle", "tube", "box", "custom"});
+  if (!shape) {
+    r.allow({"width", "height", "diameter", "outer_diameter", "wall", "S", "Ix", "Iy", "Iz", "Wy",
+             "Wz"});
+    return std::nullopt;
+  }
   if (*shape == "rectangle") {
     const auto w = r.positive("width", true), h = r.positive("height", true);
     if (w && h) return rectangle_section(*w, *h);
@@ -82,7 +85,8 @@ std::optional<Mat3> read_inertia(ObjectReader& r) {
   if (!v) return std::nullopt;
   const Where at = r.at("inertia");
   if (!v->is_array() || (v->size() != 3 && v->size() != 6)) {
-    r.error("inertia", "expected 3 principal values or 6 tensor components [xx, yy, zz, xy, xz, yz]");
+    r.error("inertia",
+            "expected 3 principal values or 6 tensor components [xx, yy, zz, xy, xz, yz]");
     return std::nullopt;
   }
   std::vector<double> x;
@@ -106,9 +110,9 @@ std::optional<Mat3> read_inertia(ObjectReader& r) {
   }
   const double tol = 1e-9 * p.sum();
   if (p(0) + p(1) < p(2) - tol) {
-    r.error("inertia", "principal inertias violate the triangle inequality (" +
-                           number_text(p(0)) + " + " + number_text(p(1)) + " < " +
-                           number_text(p(2)) + "): no rigid body has them");
+    r.error("inertia", "principal inertias violate the triangle inequality (" + number_text(p(0)) +
+                           " + " + number_text(p(1)) + " < " + number_text(p(2)) +
+                           "): no rigid body has them");
     return std::nullopt;
   }
   return j;
@@ -120,7 +124,10 @@ std::optional<TimeFunction> read_time_function(const Json& value, const Where& w
   if (!r.is_object()) return std::nullopt;
   TimeFunction f;
   const auto type = r.choice("type", true, {"constant", "step", "ramp", "harmonic", "table"});
-  if (!type) return std::nullopt;
+  if (!type) {
+    r.allow({"at", "from", "to", "frequency", "phase", "t", "v"});
+    return std::nullopt;
+  }
   if (*type == "constant") return f;
   if (*type == "step") {
     f.type = TimeFunction::Type::kStep;
@@ -168,28 +175,44 @@ std::optional<int> body_ref(ObjectReader& r, const std::string& key, const Scene
   if (!name) return std::nullopt;
   const auto it = specs.body_index.find(*name);
   if (it == specs.body_index.end()) {
-    r.error(key, "unknown body \"" + *name + "\"");
+    if (!specs.bodies_incomplete) r.error(key, "unknown body \"" + *name + "\"");
     return std::nullopt;
   }
   return it->second;
 }
 
+// Whether an optional member is present but not of the expected kind (reported by the caller).
+bool unusable(ObjectReader& scene, const std::string& key, bool array) {
+  const Json* v = scene.member(key, false);
+  return v && (array ? !v->is_array() : !v->is_object());
+}
+
 }  // namespace
 
 void read_materials(ObjectReader& scene, SceneSpecs& specs) {
+  specs.materials_incomplete = unusable(scene, "materials", false);
   for_each_member(scene, "materials", [&](const std::string& name, const Json& v, const Where& at) {
     ObjectReader r(v, at, scene.diagnostics());
     const auto e = r.positive("E", true), g = r.positive("G", true);
     const auto rho = r.positive("density", false, true);
-    if (e && g) specs.materials[name] = {*e, *g, rho.value_or(0.0)};
+    const bool density_ok = rho || !r.member("density", false);
+    if (e && g && density_ok)
+      specs.materials[name] = {*e, *g, rho.value_or(0.0)};
+    else
+      specs.invalid_materials.insert(name);
   });
 }
 
 void read_sections(ObjectReader& scene, SceneSpecs& specs) {
+  specs.sections_incomplete = unusable(scene, "sections", false);
   for_each_member(scene, "sections", [&](const std::string& name, const Json& v, const Where& at) {
     ObjectReader r(v, at, scene.diagnostics());
-    if (!r.is_object()) return;
-    if (const auto s = read_section(r)) specs.sections[name] = *s;
+    std::optional<SectionProperties> s;
+    if (r.is_object()) s = read_section(r);
+    if (s)
+      specs.sections[name] = *s;
+    else
+      specs.invalid_sections.insert(name);
   });
 }
 
@@ -200,9 +223,13 @@ void read_bodies(ObjectReader& scene, SceneSpecs& specs) {
   specs.bodies.push_back(ground);
   specs.body_index["ground"] = 0;
   Diagnostics& diag = scene.diagnostics();
+  specs.bodies_incomplete = unusable(scene, "bodies", true);
   for_each_entry(scene, "bodies", [&](const Json& v, const Where& at) {
     ObjectReader r(v, at, diag);
-    if (!r.is_object()) return;
+    if (!r.is_object()) {
+      specs.bodies_incomplete = true;
+      return;
+    }
     BodySpec b;
     b.where = at;
     const auto name = r.string("name", true);
@@ -217,20 +244,29 @@ void read_bodies(ObjectReader& scene, SceneSpecs& specs) {
     if (orientation) {
       const Vec4 q((*orientation)[0], (*orientation)[1], (*orientation)[2], (*orientation)[3]);
       if (std::abs(q.norm() - 1.0) > 1e-3)
-        r.error("orientation", "Euler parameters must have unit norm (norm is " +
-                                   number_text(q.norm()) + ")");
+        r.error("orientation",
+                "Euler parameters must have unit norm (norm is " + number_text(q.norm()) + ")");
       else
         b.orientation = q / q.norm();
     }
-    if (b.mass && !b.inertia && !b.fixed) r.error("inertia", "a free body with a mass needs an inertia");
-    if (b.inertia && !b.mass && !b.fixed) r.error("mass", "a free body with an inertia needs a mass");
-    if (!name) return;
+    // Only when the other one is absent (an invalid one was reported already).
+    const bool has_mass = r.member("mass", false), has_inertia = r.member("inertia", false);
+    if (b.mass && !has_inertia && !b.fixed)
+      r.error("inertia", "a free body with a mass needs an inertia");
+    if (b.inertia && !has_mass && !b.fixed)
+      r.error("mass", "a free body with an inertia needs a mass");
+    if (!name) {
+      specs.bodies_incomplete = true;
+      return;
+    }
     b.name = *name;
     if (b.name.empty()) {
+      specs.bodies_incomplete = true;
       r.error("name", "must not be empty");
     } else if (specs.body_index.count(b.name)) {
-      r.error("name", b.name == "ground" ? "\"ground\" is the implicit fixed body; choose another name"
-                                         : "duplicate body name \"" + b.name + "\"");
+      r.error("name", b.name == "ground"
+                          ? "\"ground\" is the implicit fixed body; choose another name"
+                          : "duplicate body name \"" + b.name + "\"");
     } else {
       specs.body_index[b.name] = static_cast<int>(specs.bodies.size());
       specs.bodies.push_back(b);
@@ -283,15 +319,33 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
     e.damping = r.positive("damping", false, true).value_or(0.0);
     const auto form = r.choice("formulation", false, {"energy", "paper"});
     if (form && *form == "paper") e.formulation = Formulation::kPaper;
-    e.segments = r.integer("segments", false, 0).value_or(0);
+    const auto segments = r.integer("segments", false, 0);
+    if (segments && *segments > kMaxSegments) {
+      r.error("segments", "at most " + std::to_string(kMaxSegments) + " segments");
+      e.segments = 0;
+    } else {
+      e.segments = segments.value_or(0);
+    }
     if (rails) e.min_length = r.positive("min_length", false);
     bool ok = name && b1 && b2 && p1 && p2 && p3 && material && section;
+    if (name) {
+      if (name->empty()) {
+        r.error("name", "must not be empty");
+        ok = false;
+      } else if (!specs.element_names.insert(*name).second) {
+        r.error("name", "duplicate element name \"" + *name + "\" (beams and rails share names)");
+        ok = false;
+      }
+    }
+    // A material or section declared but invalid was reported where it is declared.
     if (material && !specs.materials.count(*material)) {
-      r.error("material", "unknown material \"" + *material + "\"");
+      if (!specs.invalid_materials.count(*material) && !specs.materials_incomplete)
+        r.error("material", "unknown material \"" + *material + "\"");
       ok = false;
     }
     if (section && !specs.sections.count(*section)) {
-      r.error("section", "unknown section \"" + *section + "\"");
+      if (!specs.invalid_sections.count(*section) && !specs.sections_incomplete)
+        r.error("section", "unknown section \"" + *section + "\"");
       ok = false;
     }
     if (b1 && b2 && *b1 == *b2) {
@@ -308,11 +362,6 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
       ok = false;
     }
     if (!ok) return;
-    for (const ElementSpec& other : specs.elements)
-      if (other.name == *name) {
-        r.error("name", "duplicate element name \"" + *name + "\" (beams and rails share names)");
-        return;
-      }
     e.name = *name, e.body1 = *b1, e.body2 = *b2, e.p1 = *p1, e.p2 = *p2, e.p3 = *p3;
     e.material = specs.materials.at(*material);
     e.section = specs.sections.at(*section);
@@ -327,6 +376,7 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     if (!r.is_object()) return;
     Load load;
     const auto type = r.choice("type", true, {"force", "torque"});
+    if (!type) r.allow({"point"});
     const auto body = body_ref(r, "body", specs);
     std::optional<Vec3> point;
     if (type && *type == "force") point = r.vec3("point", false);
@@ -334,7 +384,8 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     std::optional<TimeFunction> time = TimeFunction{};
     if (const Json* t = r.member("time", false)) time = read_time_function(*t, at / "time", diag);
     if (body && specs.bodies[*body].fixed) {
-      r.error("body", "body \"" + specs.bodies[*body].name + "\" is fixed: a load on it does nothing");
+      r.error("body",
+              "body \"" + specs.bodies[*body].name + "\" is fixed: a load on it does nothing");
       return;
     }
     if (!type || !body || !value || !time) return;

@@ -4,6 +4,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -48,7 +49,7 @@ struct ElementSpec {
   SectionProperties section;
   double damping = 0.0;
   Formulation formulation = Formulation::kEnergy;
-  long segments = 0;
+  long segments = 0;  // at most kMaxSegments
   std::optional<double> min_length;
 };
 
@@ -56,12 +57,21 @@ struct SceneSpecs {
   Vec3 gravity = Vec3::Zero();
   std::map<std::string, MaterialSpec> materials;
   std::map<std::string, SectionProperties> sections;
-  std::vector<BodySpec> bodies;  // [0] is ground
+  // Declared but invalid (already reported): elements using them are not reported again. When a
+  // whole list is unusable (not an object or array, or an entry without a usable name), a name
+  // that is not found is not reported either: it may be the one that could not be read.
+  std::set<std::string> invalid_materials, invalid_sections;
+  bool materials_incomplete = false, sections_incomplete = false, bodies_incomplete = false;
+  std::set<std::string> element_names;  // beams and rails share one name space
+  std::vector<BodySpec> bodies;         // [0] is ground
   std::map<std::string, int> body_index;
   std::vector<ElementSpec> elements;
   std::vector<Load> loads;
   std::vector<Vec3> load_points;  // global application point of each load
 };
+
+// More segments than this would only exhaust memory (every one adds a body and 13 states).
+constexpr long kMaxSegments = 1000;
 
 // Readers for each part of a scene; each reports its own problems.
 void read_materials(ObjectReader& scene, SceneSpecs& specs);

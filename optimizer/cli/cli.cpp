@@ -15,7 +15,8 @@
 namespace beamrail {
 namespace {
 
-constexpr const char* kUsage = R"(beamrail - design optimizer for rigid bodies joined by elastic beams and rails
+constexpr const char* kUsage =
+    R"(beamrail - design optimizer for rigid bodies joined by elastic beams and rails
 
 Usage:
   beamrail run STUDY.json [-o OUTDIR] [-j THREADS] [--resume] [--quiet]
@@ -45,8 +46,12 @@ struct RunArguments {
   bool quiet = false;
 };
 
+// The message and the usage lines only: the full help would bury the message.
 int usage_error(const std::string& message) {
-  std::cerr << "beamrail: " << message << "\n\n" << kUsage;
+  std::cerr << "beamrail: " << message << "\n"
+            << "usage: beamrail run STUDY.json [-o OUTDIR] [-j THREADS] [--resume] [--quiet]\n"
+            << "       beamrail check STUDY.json\n"
+            << "       beamrail --help | --version\n";
   return 2;
 }
 
@@ -111,9 +116,9 @@ int run(const RunArguments& args) {
     std::cerr << diag.format();
     return 2;
   }
-  const std::filesystem::path out =
-      args.output.empty() ? std::filesystem::path("results") / study->name
-                          : std::filesystem::path(args.output);
+  const std::filesystem::path out = args.output.empty()
+                                        ? std::filesystem::path("results") / study->name
+                                        : std::filesystem::path(args.output);
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec || !std::filesystem::is_directory(out)) {

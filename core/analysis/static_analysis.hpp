@@ -17,7 +17,7 @@ struct StaticOptions {
   // Time at which the loads are evaluated [s]; +infinity: each load's final value.
   double time = std::numeric_limits<double>::infinity();
   int load_steps = 0;         // 0: automatic (one step, subdivided on failure); n: n equal steps
-  int max_iterations = 50;    // Newton iterations per load step
+  int max_iterations = 30;    // Newton iterations per load step
   double tolerance = 1e-10;   // residual, relative to the applied load scale
   int max_load_steps = 1000;  // total load increments allowed (including subdivisions)
 };

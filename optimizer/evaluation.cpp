@@ -1,123 +1,177 @@
 #include "optimizer/evaluation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
-#include "core/model/rotation.hpp"
-#include "optimizer/tables.hpp"
+#include "optimizer/responses.hpp"
+#include "optimizer/result_tables.hpp"
 
 namespace beamrail {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Bodies listed in the time series: the scene's own free bodies (not generated segment nodes).
-std::vector<int> reported_bodies(const Model& model) {
-  std::vector<int> out;
-  for (int i : model.free_bodies)
-    if (!model.bodies[i].generated) out.push_back(i);
-  return out;
-}
+class Runner {
+ public:
+  Runner(const Study& study, const Model& model, const EvaluationOptions& options, Evaluation& ev)
+      : study_(study), model_(model), options_(options), ev_(ev), static_data_(model) {}
 
-// Displacement of a body point along a direction, from the initial configuration.
-struct PointTracker {
-  int body;
-  Vec3 offset;  // body axes
-  Vec3 initial;
-  Vec3 direction;
-  double value(const Data& data) const {
-    const Pose<double>& p = data.pose[body];
-    return (p.c + p.A * offset - initial).dot(direction);
+  // Runs one analysis; false when it failed (the evaluation then stops).
+  bool run(const AnalysisSpec& spec) {
+    AnalysisReport report;
+    switch (spec.type) {
+      case AnalysisSpec::Type::kStatic:
+        report = run_static(spec.statics, true);
+        break;
+      case AnalysisSpec::Type::kModal:
+        report = run_modal(spec);
+        break;
+      case AnalysisSpec::Type::kTransient:
+        report = run_transient_analysis(spec);
+        break;
+    }
+    const bool ok = report.ok;
+    if (!ok) {
+      ev_.status = "failed";
+      ev_.message = report.type + " analysis: " + report.message;
+    }
+    ev_.analyses.push_back(std::move(report));
+    return ok;
   }
+
+ private:
+  // The static equilibrium, solved once; `listed` when the study asked for the static analysis
+  // itself (then its tables are written and its responses computed).
+  AnalysisReport run_static(const StaticOptions& options, bool listed) {
+    AnalysisReport report;
+    report.type = "static";
+    if (!static_result_) {
+      static_options_ = options;
+      static_result_ = solve_static(model_, options, static_data_);
+    }
+    const StaticResult& r = *static_result_;
+    report.ok = r.ok;
+    report.message = r.message;
+    report.wall_seconds = r.wall_seconds;
+    report.statics = r;
+    if (!listed || !r.ok) return report;
+    add_warnings(r.warnings);
+    static_responses(study_, model_, static_data_, ev_.responses);
+    if (!options_.output_directory.empty()) {
+      std::string error;
+      if (!write_static_tables(options_.output_directory, model_, static_data_, &error)) {
+        report.ok = false;
+        report.message = error;
+      }
+    }
+    return report;
+  }
+
+  AnalysisReport run_modal(const AnalysisSpec& spec) {
+    AnalysisReport report;
+    report.type = "modal";
+    report.about = spec.about_static ? "static" : "initial";
+    Data data(model_);
+    ModalOptions options = spec.modal;
+    if (spec.about_static) {
+      // The static analysis listed in the study, or one with default options.
+      const int listed = find_analysis(study_, AnalysisSpec::Type::kStatic);
+      const AnalysisReport equilibrium =
+          run_static(listed >= 0 ? study_.analyses[listed].statics : StaticOptions{}, false);
+      report.statics = equilibrium.statics;
+      if (!equilibrium.ok) {
+        report.message = "no static equilibrium to linearize about: " + equilibrium.message;
+        return report;
+      }
+      data.pose = static_data_.pose;
+      data.q = static_data_.q;
+      options.time = static_options_.time;
+    }
+    const ModalResult r = solve_modal(model_, options, data);
+    report.ok = r.ok;
+    report.message = r.message;
+    report.wall_seconds = r.wall_seconds;
+    report.eigensolver = r.solver;
+    report.rigid_modes = r.rigid_modes;
+    report.modes = static_cast<int>(r.modes.size()) - r.rigid_modes;
+    report.asymmetry = r.asymmetry;
+    add_warnings(r.warnings);
+    if (!r.ok) return report;
+    modal_responses(study_, r, ev_.responses);
+    if (!options_.output_directory.empty()) {
+      std::string error;
+      if (!write_modal_tables(options_.output_directory, model_, r, &error)) {
+        report.ok = false;
+        report.message = error;
+      }
+    }
+    return report;
+  }
+
+  AnalysisReport run_transient_analysis(const AnalysisSpec& spec) {
+    AnalysisReport report;
+    report.type = "transient";
+    Data data(model_);
+    std::vector<std::pair<size_t, PointTracker>> peaks;
+    for (size_t k = 0; k < study_.responses.size(); ++k)
+      if (study_.responses[k].quantity == ResponseSpec::Quantity::kPeakDisplacement) {
+        peaks.emplace_back(k, PointTracker(model_, study_.responses[k]));
+        ev_.responses[k] = 0.0;
+      }
+    TimeseriesWriter table;
+    std::string table_error;
+    if (!options_.output_directory.empty())
+      table.open(options_.output_directory / "timeseries.csv", model_, &table_error);
+
+    bool first = true;
+    double scale = 0.0;
+    const auto observer = [&](const TransientSample& s, const Data& d) {
+      if (first) report.energy_initial = s.energy(), first = false;
+      report.energy_final = s.energy();
+      scale = std::max({scale, std::abs(report.energy_initial), s.kinetic + std::abs(s.elastic)});
+      if (scale > 0.0)
+        report.energy_max_relative_change =
+            std::max(report.energy_max_relative_change,
+                     std::abs(s.energy() - report.energy_initial) / scale);
+      for (auto& [k, t] : peaks)
+        ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
+      if (table.good()) table.write(s, d);
+    };
+    const TransientResult result = run_transient(model_, spec.transient, data, observer);
+    table.flush();
+    report.ok = result.ok;
+    report.message = result.message;
+    report.stats = result.stats;
+    report.wall_seconds = result.stats.wall_seconds;
+    report.t_reached = result.t_reached;
+    add_warnings(result.warnings);
+    if (!table_error.empty()) {
+      report.ok = false;
+      report.message = table_error;
+    }
+    if (!result.ok)
+      for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
+    return report;
+  }
+
+  void add_warnings(const std::vector<std::string>& warnings) {
+    for (const std::string& w : warnings)
+      if (std::find(ev_.warnings.begin(), ev_.warnings.end(), w) == ev_.warnings.end())
+        ev_.warnings.push_back(w);
+  }
+
+  const Study& study_;
+  const Model& model_;
+  const EvaluationOptions& options_;
+  Evaluation& ev_;
+  Data static_data_;
+  StaticOptions static_options_;
+  std::optional<StaticResult> static_result_;
 };
 
-PointTracker tracker(const Model& model, const ResponseSpec& r) {
-  const Body& b = model.bodies[r.body];
-  const Mat3 a0 = rotation_matrix<double>(b.orientation);
-  return {r.body, a0.transpose() * (r.point - b.position), r.point, r.direction};
-}
-
-AnalysisReport run_transient_analysis(const Study& study, const Model& model,
-                                      const AnalysisSpec& spec, const EvaluationOptions& options,
-                                      Evaluation& evaluation) {
-  AnalysisReport report;
-  report.type = "transient";
-  Data data(model);
-
-  // Responses fed by this analysis.
-  std::vector<std::pair<size_t, PointTracker>> peaks;
-  for (size_t k = 0; k < study.responses.size(); ++k)
-    if (study.responses[k].quantity == ResponseSpec::Quantity::kPeakDisplacement) {
-      peaks.emplace_back(k, tracker(model, study.responses[k]));
-      evaluation.responses[k] = 0.0;
-    }
-
-  CsvWriter table;
-  const std::vector<int> bodies = reported_bodies(model);
-  std::string table_error;
-  if (!options.output_directory.empty()) {
-    std::vector<std::string> header{"t"};
-    for (int i : bodies)
-      for (const char* c : {".x", ".y", ".z", ".q0", ".q1", ".q2", ".q3"})
-        header.push_back(model.bodies[i].name + c);
-    header.push_back("energy");
-    table.open(options.output_directory / "timeseries.csv", header, &table_error);
-  }
-
-  bool first = true;
-  double scale = 0.0;
-  std::vector<double> row;
-  const auto observer = [&](const TransientSample& s, const Data& d) {
-    if (first) {
-      report.energy_initial = s.energy();
-      first = false;
-    }
-    report.energy_final = s.energy();
-    scale = std::max({scale, std::abs(report.energy_initial), s.kinetic + std::abs(s.elastic)});
-    if (scale > 0.0)
-      report.energy_max_relative_change = std::max(
-          report.energy_max_relative_change, std::abs(s.energy() - report.energy_initial) / scale);
-    for (auto& [k, t] : peaks)
-      evaluation.responses[k] = std::max(evaluation.responses[k], std::abs(t.value(d)));
-    if (table.good()) {
-      row.clear();
-      row.push_back(s.t);
-      for (int i : bodies) {
-        const Pose<double>& p = d.pose[i];
-        const Vec4 q = d.q[i] / d.q[i].norm();
-        row.insert(row.end(), {p.c(0), p.c(1), p.c(2), q(0), q(1), q(2), q(3)});
-      }
-      row.push_back(s.energy());
-      table.row(row);
-    }
-  };
-  const TransientResult result = run_transient(model, spec.transient, data, observer);
-  table.flush();
-  report.ok = result.ok;
-  report.message = result.message;
-  report.stats = result.stats;
-  report.t_end = result.t_reached;
-  evaluation.warnings.insert(evaluation.warnings.end(), result.warnings.begin(),
-                             result.warnings.end());
-  if (!table_error.empty()) {
-    report.ok = false;
-    report.message = table_error;
-  }
-  if (!result.ok)
-    for (auto& [k, t] : peaks) evaluation.responses[k] = kNaN;  // a partial peak is no peak
-  return report;
-}
-
 }  // namespace
-
-double structural_mass(const Model& model) {
-  double m = 0.0;
-  for (const Body& b : model.bodies) m += b.declared_mass;
-  for (const Beam& e : model.beams) m += e.density * e.section.area * e.ends.length;
-  for (const Rail& e : model.rails) m += e.density * e.section.area * e.ends.length;
-  return m;
-}
 
 Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -127,17 +181,9 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
     for (size_t k = 0; k < study.responses.size(); ++k)
       if (study.responses[k].quantity == ResponseSpec::Quantity::kMass)
         ev.responses[k] = structural_mass(model);
-    for (const AnalysisSpec& spec : study.analyses) {
-      AnalysisReport report = run_transient_analysis(study, model, spec, options, ev);
-      const bool ok = report.ok;
-      const std::string message = report.message;
-      ev.analyses.push_back(std::move(report));
-      if (!ok) {
-        ev.status = "failed";
-        ev.message = "transient analysis: " + message;
-        break;
-      }
-    }
+    Runner runner(study, model, options, ev);
+    for (const AnalysisSpec& spec : study.analyses)
+      if (!runner.run(spec)) break;
   } catch (const std::exception& e) {
     ev.status = "failed";
     ev.message = e.what();

@@ -3,23 +3,35 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
 #include "optimizer/study.hpp"
 
 namespace beamrail {
 
 struct AnalysisReport {
-  std::string type;   // "transient", ...
+  std::string type;  // "transient", "static", "modal"
   bool ok = false;
   std::string message;
+  double wall_seconds = 0.0;
+  // transient
   SolverStats stats;
-  double t_end = 0.0;            // transient: time reached [s]
-  double energy_initial = 0.0;   // transient: total energy at t = 0 [J]
-  double energy_final = 0.0;     // transient: total energy at the last sample [J]
-  double energy_max_relative_change = 0.0;  // transient: max |E - E0| / max(|E0|, kinetic+elastic scale)
+  double t_reached = 0.0;                   // [s]
+  double energy_initial = 0.0;              // total energy at t = 0 [J]
+  double energy_final = 0.0;                // at the last sample [J]
+  double energy_max_relative_change = 0.0;  // max |E - E0| / energy scale
+  // static (also the equilibrium a modal analysis was linearized about)
+  std::optional<StaticResult> statics;
+  // modal
+  std::string about;  // "static" or "initial"
+  std::string eigensolver;
+  int modes = 0, rigid_modes = 0;
+  double asymmetry = 0.0;
 };
 
 struct Evaluation {
@@ -35,11 +47,9 @@ struct EvaluationOptions {
   std::filesystem::path output_directory;  // empty: write no tables (batch evaluations)
 };
 
-// Runs every analysis of the study on `model` (the study's own or a design's) and computes the
-// responses. Never throws.
+// Runs every analysis of the study on `model` (the study's own or a design's), in the listed
+// order (a static equilibrium needed by a modal analysis is solved once and shared), and
+// computes the responses. Never throws.
 Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options);
-
-// Total structural mass: declared body masses plus rho S l of every beam and rail with a density.
-double structural_mass(const Model& model);
 
 }  // namespace beamrail

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
 #include "core/model/model.hpp"
 #include "core/scene/json_reader.hpp"
@@ -14,26 +16,48 @@
 namespace beamrail {
 
 struct AnalysisSpec {
-  enum class Type { kTransient };
+  enum class Type { kTransient, kStatic, kModal };
   Type type = Type::kTransient;
   TransientOptions transient;
+  StaticOptions statics;
+  ModalOptions modal;
+  bool about_static = false;  // modal: linearize about the static equilibrium (else: initial)
   Where where;
 };
 
+// Where an element's end forces are read: element kind and index, and which end (1 or 2).
+struct ElementEnd {
+  bool rail = false;
+  int index = 0;
+  int end = 1;
+};
+
 struct ResponseSpec {
-  enum class Quantity { kPeakDisplacement, kMass };
+  enum class Quantity {
+    kFrequency,         // modal: Hz of elastic mode `mode`
+    kDisplacement,      // static: displacement of a body point along `direction` [m]
+    kRotation,          // static: rotation of a body about `direction` [rad]
+    kPeakDisplacement,  // transient: largest |displacement . direction| of a body point [m]
+    kMass,              // structural mass [kg]
+    kMaxStress,         // static: largest |N|/S + |My|/Wy + |Mz|/Wz over beams [Pa]
+    kElementForce,      // static: one component of an element's end forces [N, N m]
+  };
   std::string name;
   Quantity quantity = Quantity::kMass;
-  int body = 0;                      // body index (displacement-like quantities)
-  Vec3 point = Vec3::Zero();         // global point in the initial configuration [m]
-  Vec3 direction = Vec3::UnitX();    // unit vector, global
+  int mode = 1;                    // frequency: 1-based elastic mode
+  int body = 0;                    // displacement-like quantities: body index
+  Vec3 point = Vec3::Zero();       // global point in the initial configuration [m]
+  Vec3 direction = Vec3::UnitX();  // unit vector, global (the axis of a rotation)
+  ElementEnd element;              // element_force
+  int component = 0;               // element_force: 0..5 = fx, fy, fz, mx, my, mz
+  std::vector<int> beams;          // max_stress: beam indices considered (all when empty)
   Where where;
 };
 
 struct Study {
-  std::string file;         // the study file as the user named it
+  std::string file;                 // the study file as the user named it
   std::filesystem::path directory;  // where relative paths in it are resolved
-  Json document;            // the study as read, with a scene file inlined under /scene
+  Json document;                    // the study as read, with a scene file inlined under /scene
   std::string name;
   std::string description;
   Model model;
@@ -49,7 +73,21 @@ std::optional<Study> load_study_file(const std::string& path, Diagnostics& diag)
 std::optional<Study> load_study(const Json& document, const std::string& file,
                                 const std::filesystem::path& directory, Diagnostics& diag);
 
-// The index of the analysis of the given type, or -1.
+// The index of the first analysis of the given type, or -1.
 int find_analysis(const Study& study, AnalysisSpec::Type type);
+
+// The analysis types and response quantities a study file may name.
+extern const std::vector<std::string> kAnalysisTypes;
+extern const std::vector<std::string> kResponseQuantities;
+
+// Reads one entry of "analyses" (analysis_specs.cpp). `model` (may be null when the scene has
+// errors) lets the defaults depend on the scene.
+std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where, const Model* model,
+                                          Diagnostics& diag);
+
+// Reads one named response (response_specs.cpp); model may be null when the scene has errors.
+std::optional<ResponseSpec> read_response(const std::string& name, const Json& value,
+                                          const Where& where, const Study& study,
+                                          const Model* model, Diagnostics& diag);
 
 }  // namespace beamrail

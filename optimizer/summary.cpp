@@ -41,18 +41,39 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
     nlohmann::json j{{"type", a.type},
                      {"status", a.ok ? "ok" : "failed"},
                      {"message", a.message},
-                     {"wall_seconds", a.stats.wall_seconds},
-                     {"steps", a.stats.steps},
-                     {"rhs_evaluations", a.stats.rhs_evaluations},
-                     {"jacobian_evaluations", a.stats.jacobian_evaluations},
-                     {"nonlinear_iterations", a.stats.nonlinear_iterations},
-                     {"nonlinear_failures", a.stats.nonlinear_failures},
-                     {"error_test_failures", a.stats.error_test_failures}};
+                     {"wall_seconds", a.wall_seconds}};
     if (a.type == "transient") {
-      j["t_reached"] = a.t_end;
+      j["steps"] = a.stats.steps;
+      j["rhs_evaluations"] = a.stats.rhs_evaluations;
+      j["jacobian_evaluations"] = a.stats.jacobian_evaluations;
+      j["nonlinear_iterations"] = a.stats.nonlinear_iterations;
+      j["nonlinear_failures"] = a.stats.nonlinear_failures;
+      j["error_test_failures"] = a.stats.error_test_failures;
+      j["t_reached"] = a.t_reached;
       j["energy_initial"] = json_number(a.energy_initial);
       j["energy_final"] = json_number(a.energy_final);
       j["energy_max_relative_change"] = json_number(a.energy_max_relative_change);
+    }
+    if (a.statics) {
+      const StaticResult& r = *a.statics;
+      nlohmann::json st{{"converged", r.ok},
+                        {"iterations", r.iterations},
+                        {"load_steps", r.load_steps},
+                        {"residual_norm", json_number(r.residual_norm)},
+                        {"reference_force", json_number(r.reference_force)},
+                        {"singular_directions", r.singular_directions},
+                        {"wall_seconds", r.wall_seconds}};
+      if (a.type == "static")
+        j.update(st);
+      else
+        j["equilibrium"] = st;
+    }
+    if (a.type == "modal") {
+      j["about"] = a.about;
+      j["eigensolver"] = a.eigensolver;
+      j["elastic_modes"] = a.modes;
+      j["rigid_body_modes"] = a.rigid_modes;
+      j["stiffness_asymmetry"] = json_number(a.asymmetry);
     }
     analyses.push_back(j);
   }

@@ -120,8 +120,8 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
   const auto start = std::chrono::steady_clock::now();
   ModalResult result;
   try {
-    compute_wrenches(model, data, options.time);
-    compute_tangent(model, data, options.time, false);
+    compute_wrenches(model, data, options.time, options.load_factor);
+    compute_tangent(model, data, options.time, false, options.load_factor);
     const SparseMatrix s = stiffness_matrix(model, data);
     const SparseMatrix k = -s;
     const SparseMatrix kt = SparseMatrix(k.transpose());

@@ -21,6 +21,7 @@ struct ModalOptions {
   EigenSolverKind solver = EigenSolverKind::kAuto;
   int dense_limit = 600;  // kAuto: dense up to this many degrees of freedom
   double time = std::numeric_limits<double>::infinity();  // loads' time (load stiffness)
+  double load_factor = 1.0;  // 0: linearize the unloaded structure (no load stiffness)
 };
 
 struct Mode {

@@ -1,0 +1,139 @@
+// Reading the "analyses" entries of a study: transient, static and modal.
+#include <cmath>
+
+#include "optimizer/study.hpp"
+
+namespace beamrail {
+
+const std::vector<std::string> kAnalysisTypes = {"transient", "static", "modal"};
+
+namespace {
+
+void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
+                     IntegratorOptions& io) {
+  ObjectReader r(value, where, diag);
+  if (!r.is_object()) return;
+  if (const auto m = r.choice("method", false, {"bdf"})) io.method = *m;
+  io.rtol = r.positive("rtol", false).value_or(io.rtol);
+  io.atol = r.positive("atol", false).value_or(io.atol);
+  if (const auto j = r.choice("jacobian", false, {"exact", "fd"}))
+    io.jacobian = *j == "exact" ? JacobianKind::kExact : JacobianKind::kFiniteDifference;
+  if (const auto s = r.choice("linear_solver", false, {"auto", "dense"}))
+    io.linear_solver = *s == "dense" ? LinearSolverKind::kDense : LinearSolverKind::kAuto;
+  if (const auto q = r.integer("max_order", false, 1)) {
+    if (*q > 5)
+      r.error("max_order", "BDF orders go from 1 to 5");
+    else
+      io.max_order = static_cast<int>(*q);
+  }
+  io.max_step = r.positive("max_step", false).value_or(0.0);
+  io.initial_step = r.positive("initial_step", false).value_or(0.0);
+  io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
+}
+
+bool read_transient(ObjectReader& r, AnalysisSpec& a) {
+  const auto t_end = r.positive("t_end", true);
+  const auto step = r.positive("output_step", false);
+  if (const Json* i = r.member("integrator", false))
+    read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
+  if (!t_end) return false;
+  a.transient.t_end = *t_end;
+  a.transient.output_step = step.value_or(*t_end / 100.0);
+  if (a.transient.output_step > *t_end) {
+    r.error("output_step", "must not exceed t_end");
+    return false;
+  }
+  if (*t_end / a.transient.output_step > 1e8) {
+    r.error("output_step", "more than 1e8 output rows requested");
+    return false;
+  }
+  return true;
+}
+
+bool has_harmonic_load(const Model* model) {
+  if (!model) return false;
+  for (const Load& load : model->loads)
+    if (load.time.type == TimeFunction::Type::kHarmonic) return true;
+  return false;
+}
+
+bool read_static(ObjectReader& r, const Model* model, AnalysisSpec& a) {
+  bool ok = true;
+  if (const auto t = r.positive("time", false, true)) {
+    a.statics.time = *t;
+  } else if (has_harmonic_load(model) && !r.member("time", false)) {
+    r.error("type", "the scene has harmonic loads, which have no final value: give \"time\"");
+    ok = false;
+  }
+  if (const Json* steps = r.member("load_steps", false)) {
+    if (steps->is_string()) {
+      if (steps->get<std::string>() != "auto") {
+        r.error("load_steps", "expected \"auto\" or a number of equal load steps");
+        ok = false;
+      }
+    } else if (const auto n = r.integer("load_steps", false, 1)) {
+      if (*n > 100000) {
+        r.error("load_steps", "at most 100000 load steps");
+        ok = false;
+      } else {
+        a.statics.load_steps = static_cast<int>(*n);
+      }
+    } else {
+      ok = false;
+    }
+  }
+  a.statics.tolerance = r.positive("tolerance", false).value_or(a.statics.tolerance);
+  if (const auto n = r.integer("max_iterations", false, 1))
+    a.statics.max_iterations = static_cast<int>(std::min(*n, 10000L));
+  return ok;
+}
+
+bool read_modal(ObjectReader& r, const Model* model, AnalysisSpec& a) {
+  if (const auto n = r.integer("modes", false, 1)) {
+    if (*n > 10000) {
+      r.error("modes", "at most 10000 modes");
+      return false;
+    }
+    a.modal.modes = static_cast<int>(*n);
+  }
+  const bool loaded = model && (!model->loads.empty() || model->gravity.norm() > 0.0);
+  const auto about = r.choice("about", false, {"static", "initial"});
+  a.about_static = about ? *about == "static" : loaded;
+  if (!a.about_static) a.modal.load_factor = 0.0;
+  if (const auto s = r.choice("solver", false, {"auto", "dense", "shift-invert"}))
+    a.modal.solver = *s == "dense"          ? EigenSolverKind::kDense
+                     : *s == "shift-invert" ? EigenSolverKind::kShiftInvert
+                                            : EigenSolverKind::kAuto;
+  return true;
+}
+
+}  // namespace
+
+std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where, const Model* model,
+                                          Diagnostics& diag) {
+  ObjectReader r(value, where, diag);
+  if (!r.is_object()) return std::nullopt;
+  AnalysisSpec a;
+  a.where = where;
+  const auto type = r.choice("type", true, kAnalysisTypes);
+  if (!type) {
+    r.allow({"t_end", "output_step", "integrator", "time", "load_steps", "tolerance",
+             "max_iterations", "modes", "about", "solver"});
+    return std::nullopt;
+  }
+  bool ok = false;
+  if (*type == "transient") {
+    a.type = AnalysisSpec::Type::kTransient;
+    ok = read_transient(r, a);
+  } else if (*type == "static") {
+    a.type = AnalysisSpec::Type::kStatic;
+    ok = read_static(r, model, a);
+  } else {
+    a.type = AnalysisSpec::Type::kModal;
+    ok = read_modal(r, model, a);
+  }
+  if (!ok) return std::nullopt;
+  return a;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,72 @@
+#include "optimizer/responses.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "core/model/element_forces.hpp"
+#include "core/model/rotation.hpp"
+
+namespace beamrail {
+
+double structural_mass(const Model& model) {
+  double m = 0.0;
+  for (const Body& b : model.bodies) m += b.declared_mass;
+  for (const Beam& e : model.beams) m += e.density * e.section.area * e.ends.length;
+  for (const Rail& e : model.rails) m += e.density * e.section.area * e.ends.length;
+  return m;
+}
+
+PointTracker::PointTracker(const Model& model, const ResponseSpec& spec)
+    : body_(spec.body), initial_(spec.point), direction_(spec.direction) {
+  const Body& b = model.bodies[spec.body];
+  offset_ = rotation_matrix<double>(b.orientation).transpose() * (spec.point - b.position);
+}
+
+double PointTracker::value(const Data& data) const {
+  const Pose<double>& p = data.pose[body_];
+  return (p.c + p.A * offset_ - initial_).dot(direction_);
+}
+
+void static_responses(const Study& study, const Model& model, const Data& data,
+                      std::vector<double>& values) {
+  for (size_t k = 0; k < study.responses.size(); ++k) {
+    const ResponseSpec& r = study.responses[k];
+    switch (r.quantity) {
+      case ResponseSpec::Quantity::kDisplacement:
+        values[k] = PointTracker(model, r).value(data);
+        break;
+      case ResponseSpec::Quantity::kRotation: {
+        const Mat3 a0 = rotation_matrix<double>(model.bodies[r.body].orientation);
+        values[k] = rotation_vector(data.pose[r.body].A * a0.transpose()).dot(r.direction);
+        break;
+      }
+      case ResponseSpec::Quantity::kElementForce: {
+        const EndForces f = r.element.rail ? rail_end_forces(model, data, r.element.index)
+                                           : beam_end_forces(model, data, r.element.index);
+        values[k] = (r.element.end == 1 ? f.end1 : f.end2)(r.component);
+        break;
+      }
+      case ResponseSpec::Quantity::kMaxStress: {
+        double worst = 0.0;
+        for (int i : r.beams)
+          worst =
+              std::max(worst, end_stress(model.beams[i].section, beam_end_forces(model, data, i)));
+        values[k] = worst;
+        break;
+      }
+      default:
+        break;
+    }
+  }
+}
+
+void modal_responses(const Study& study, const ModalResult& result, std::vector<double>& values) {
+  for (size_t k = 0; k < study.responses.size(); ++k) {
+    const ResponseSpec& r = study.responses[k];
+    if (r.quantity != ResponseSpec::Quantity::kFrequency) continue;
+    const Mode* mode = elastic_mode(result, r.mode);
+    values[k] = mode ? mode->frequency_hz : std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+}  // namespace beamrail

@@ -1,0 +1,35 @@
+// Computing the study's named responses from analysis results.
+#pragma once
+
+#include <vector>
+
+#include "core/analysis/modal_analysis.hpp"
+#include "core/model/data.hpp"
+#include "optimizer/study.hpp"
+
+namespace beamrail {
+
+// Total structural mass: declared body masses plus rho S l of every beam and rail with a density.
+double structural_mass(const Model& model);
+
+// Displacement along a direction of a body point, from the initial configuration.
+class PointTracker {
+ public:
+  PointTracker(const Model& model, const ResponseSpec& spec);
+  double value(const Data& data) const;
+
+ private:
+  int body_;
+  Vec3 offset_;  // body axes
+  Vec3 initial_, direction_;
+};
+
+// Fills the static responses (displacement, rotation, element_force, max_stress) from the
+// equilibrium in data; others are left alone.
+void static_responses(const Study& study, const Model& model, const Data& data,
+                      std::vector<double>& values);
+
+// Fills the frequency responses from a modal result.
+void modal_responses(const Study& study, const ModalResult& result, std::vector<double>& values);
+
+}  // namespace beamrail

@@ -1,0 +1,90 @@
+#include "optimizer/result_tables.hpp"
+
+#include "core/model/element_forces.hpp"
+#include "core/model/rotation.hpp"
+
+namespace beamrail {
+
+bool TimeseriesWriter::open(const std::filesystem::path& path, const Model& model,
+                            std::string* error) {
+  std::vector<std::string> header{"t"};
+  for (int i : model.free_bodies) {
+    if (model.bodies[i].generated) continue;
+    bodies_.push_back(i);
+    for (const char* c : {".x", ".y", ".z", ".q0", ".q1", ".q2", ".q3"})
+      header.push_back(model.bodies[i].name + c);
+  }
+  header.push_back("energy");
+  return table_.open(path, header, error);
+}
+
+void TimeseriesWriter::write(const TransientSample& sample, const Data& data) {
+  row_.clear();
+  row_.push_back(sample.t);
+  for (int i : bodies_) {
+    const Pose<double>& p = data.pose[i];
+    const Vec4 q = data.q[i] / data.q[i].norm();
+    row_.insert(row_.end(), {p.c(0), p.c(1), p.c(2), q(0), q(1), q(2), q(3)});
+  }
+  row_.push_back(sample.energy());
+  table_.row(row_);
+}
+
+bool write_static_tables(const std::filesystem::path& directory, const Model& model,
+                         const Data& data, std::string* error) {
+  CsvWriter displacements;
+  if (!displacements.open(directory / "static_displacements.csv",
+                          {"body", "dx", "dy", "dz", "rx", "ry", "rz"}, error))
+    return false;
+  for (int i : model.free_bodies) {
+    const Body& b = model.bodies[i];
+    const Vec3 d = data.pose[i].c - b.position;
+    const Vec3 r =
+        rotation_vector(data.pose[i].A * rotation_matrix<double>(b.orientation).transpose());
+    displacements.row({b.name, format_number(d(0)), format_number(d(1)), format_number(d(2)),
+                       format_number(r(0)), format_number(r(1)), format_number(r(2))});
+  }
+  CsvWriter forces;
+  if (!forces.open(directory / "element_forces.csv",
+                   {"element", "end", "fx", "fy", "fz", "mx", "my", "mz"}, error))
+    return false;
+  const auto rows = [&](const std::string& name, const EndForces& f) {
+    for (int end = 1; end <= 2; ++end) {
+      const Vec6& v = end == 1 ? f.end1 : f.end2;
+      std::vector<std::string> row{name, std::to_string(end)};
+      for (int c = 0; c < 6; ++c) row.push_back(format_number(v(c)));
+      forces.row(row);
+    }
+  };
+  for (size_t i = 0; i < model.beams.size(); ++i)
+    rows(model.beams[i].name, beam_end_forces(model, data, static_cast<int>(i)));
+  for (size_t i = 0; i < model.rails.size(); ++i)
+    rows(model.rails[i].name, rail_end_forces(model, data, static_cast<int>(i)));
+  return displacements.flush() && forces.flush();
+}
+
+bool write_modal_tables(const std::filesystem::path& directory, const Model& model,
+                        const ModalResult& result, std::string* error) {
+  CsvWriter modes, shapes;
+  if (!modes.open(directory / "modes.csv", {"mode", "frequency_hz", "kind"}, error) ||
+      !shapes.open(directory / "mode_shapes.csv",
+                   {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error))
+    return false;
+  int elastic = 0;
+  for (const Mode& mode : result.modes) {
+    const char* kind = mode.kind == Mode::Kind::kRigid      ? "rigid"
+                       : mode.kind == Mode::Kind::kUnstable ? "unstable"
+                                                            : "elastic";
+    const int number = mode.kind == Mode::Kind::kRigid ? 0 : ++elastic;
+    modes.row({std::to_string(number), format_number(mode.frequency_hz), kind});
+    if (mode.kind == Mode::Kind::kRigid) continue;
+    for (int k = 0; k < model.n_free(); ++k) {
+      std::vector<std::string> row{std::to_string(number), model.bodies[model.free_bodies[k]].name};
+      for (int c = 0; c < 6; ++c) row.push_back(format_number(mode.shape(6 * k + c)));
+      shapes.row(row);
+    }
+  }
+  return modes.flush() && shapes.flush();
+}
+
+}  // namespace beamrail

@@ -77,8 +77,8 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
             study.responses.push_back(*s);
       }
     }
-    if (r.member("study", false))
-      r.error("study", "design studies (sweep, optimize) are not available in this version");
+    if (const Json* design = r.member("study", false))
+      study.design = read_design_study(*design, root / "study", study, diag);
   }
 
   if (diag.size() > errors_before || !model) return std::nullopt;

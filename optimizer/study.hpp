@@ -12,6 +12,7 @@
 #include "core/analysis/transient.hpp"
 #include "core/model/model.hpp"
 #include "core/scene/json_reader.hpp"
+#include "optimizer/design_study.hpp"
 
 namespace beamrail {
 
@@ -63,6 +64,7 @@ struct Study {
   Model model;
   std::vector<AnalysisSpec> analyses;
   std::vector<ResponseSpec> responses;
+  std::optional<DesignStudy> design;  // without it the analyses run once
 };
 
 // Reads, validates and builds a study from a file. Reports every problem; nullopt if any.

@@ -7,6 +7,8 @@
 #include <new>
 
 #include "optimizer/evaluation.hpp"
+#include "optimizer/optimize.hpp"
+#include "optimizer/sweep.hpp"
 #include "optimizer/study.hpp"
 #include "optimizer/summary.hpp"
 #include "optimizer/tables.hpp"
@@ -126,6 +128,11 @@ int run(const RunArguments& args) {
               << "\n";
     return 1;
   }
+
+  const RunSettings settings{out, args.threads, args.resume, args.quiet};
+  if (study->design)
+    return study->design->type == DesignStudy::Type::kSweep ? run_sweep(*study, settings)
+                                                            : run_optimize(*study, settings);
 
   const Evaluation ev = evaluate(*study, study->model, {out});
   const nlohmann::json summary = evaluation_summary(*study, study->model, ev);

@@ -1,0 +1,146 @@
+#include "optimizer/batch_table.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "optimizer/tables.hpp"
+
+namespace beamrail {
+namespace {
+
+std::string join(const CsvRow& row) {
+  std::string line;
+  for (size_t i = 0; i < row.size(); ++i) {
+    if (i) line += ',';
+    line += csv_field(row[i]);
+  }
+  return line + '\n';
+}
+
+bool write_all(int fd, const std::string& text) {
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    done += static_cast<size_t>(n);
+  }
+  return true;
+}
+
+// Reads the whole lines of a file; the byte length of those lines goes to *whole_bytes.
+std::vector<std::string> whole_lines(const std::filesystem::path& path, size_t* whole_bytes) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::string> lines;
+  size_t start = 0;
+  *whole_bytes = 0;
+  for (size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '\n') {
+      lines.push_back(text.substr(start, i - start));
+      start = i + 1;
+      *whole_bytes = start;
+    }
+  return lines;
+}
+
+}  // namespace
+
+CsvRow parse_csv_line(const std::string& line) {
+  CsvRow out(1);
+  bool quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+        out.back() += '"', ++i;
+      else if (c == '"')
+        quoted = false;
+      else
+        out.back() += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+bool BatchTable::open(const std::filesystem::path& path, const CsvRow& header, bool resume,
+                      std::vector<CsvRow>* existing, std::string* error) {
+  path_ = path;
+  header_ = header;
+  existing->clear();
+  std::error_code ec;
+  if (resume && std::filesystem::exists(path, ec)) {
+    size_t whole = 0;
+    const std::vector<std::string> lines = whole_lines(path, &whole);
+    if (lines.empty() || parse_csv_line(lines.front()) != header) {
+      *error = "cannot resume: " + path.string() +
+               " was written by a different study (its columns differ); remove it or run "
+               "without --resume";
+      return false;
+    }
+    for (size_t i = 1; i < lines.size(); ++i) {
+      CsvRow row = parse_csv_line(lines[i]);
+      if (row.size() == header.size()) existing->push_back(std::move(row));
+    }
+    // Drop an unfinished last line, then append after the whole rows.
+    std::filesystem::resize_file(path, whole, ec);
+    fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  } else {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ >= 0) ok_ = write_all(fd_, join(header));
+  }
+  if (fd_ < 0 || !ok_) {
+    *error = "cannot write " + path.string() + ": " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+bool BatchTable::append(const CsvRow& row) {
+  const std::string line = join(row);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (fd_ < 0) return false;
+  ok_ = write_all(fd_, line) && ok_;
+  return ok_;
+}
+
+bool BatchTable::finalize(const std::vector<int>& key_columns, std::string* error) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  if (!ok_) {
+    *error = "writing " + path_.string() + " failed";
+    return false;
+  }
+  size_t whole = 0;
+  const std::vector<std::string> lines = whole_lines(path_, &whole);
+  std::map<std::vector<double>, CsvRow> rows;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    CsvRow row = parse_csv_line(lines[i]);
+    if (row.size() != header_.size()) continue;
+    std::vector<double> key;
+    for (int c : key_columns) key.push_back(std::strtod(row[c].c_str(), nullptr));
+    rows.emplace(std::move(key), std::move(row));
+  }
+  std::string text = join(header_);
+  for (const auto& [key, row] : rows) text += join(row);
+  return write_file_atomically(path_, text, error);
+}
+
+}  // namespace beamrail

@@ -1,0 +1,69 @@
+// Design studies (SPEC.md "study"): design variables addressing numbers of the study file by JSON
+// pointer, sweeps over them, and NLopt optimization of the responses.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/scene/json_reader.hpp"
+
+namespace beamrail {
+
+struct DesignVariable {
+  std::string name;
+  std::vector<std::string> pointers;  // RFC 6901, into the study document (scene inlined)
+  std::vector<double> factors;        // number written at pointers[i] = factors[i] * value
+  std::vector<double> values;         // sweep/grid: explicit values
+  double lower = 0.0, upper = 0.0;
+  int count = 0;                  // sweep/grid: lower..upper in count steps (when values is empty)
+  std::optional<double> initial;  // optimize: first start's value
+  Where where;
+};
+
+struct SweepPlan {
+  enum class Sampling { kGrid, kList, kLhs };
+  Sampling sampling = Sampling::kGrid;
+  std::vector<std::vector<double>> rows;  // list: explicit designs
+  int samples = 0;                        // lhs
+  unsigned long seed = 1;                 // lhs
+};
+
+struct Constraint {
+  enum class Kind { kAtLeast, kAtMost, kAbsAtMost };  // ">=", "<=", "abs<="
+  int response = 0;                                   // index into study.responses
+  Kind kind = Kind::kAtLeast;
+  double bound = 0.0;
+};
+
+struct OptimizePlan {
+  enum class Goal { kMinimize, kMaximize, kTarget };
+  Goal goal = Goal::kMinimize;
+  int response = 0;                             // minimize/maximize
+  std::vector<std::pair<int, double>> targets;  // target: (response, value)
+  std::vector<Constraint> constraints;
+  std::string algorithm = "LN_COBYLA";  // any NLopt name
+  std::string local_algorithm;          // for AUGLAG/MLSL wrappers (default chosen)
+  int max_evaluations = 200;            // per start
+  double xtol_rel = 1e-6, ftol_rel = 0.0, max_seconds = 0.0;
+  int starts = 1;
+  unsigned long seed = 1;
+  double gradient_step = 1e-6;  // central differences: h = step * (upper - lower)
+};
+
+struct DesignStudy {
+  enum class Type { kSweep, kOptimize };
+  Type type = Type::kSweep;
+  std::vector<DesignVariable> variables;
+  SweepPlan sweep;
+  OptimizePlan optimize;
+};
+
+struct Study;
+
+// Reads the "study" object; `study` supplies the responses and the document the pointers must
+// address. Reports every problem.
+std::optional<DesignStudy> read_design_study(const Json& value, const Where& where,
+                                             const Study& study, Diagnostics& diag);
+
+}  // namespace beamrail

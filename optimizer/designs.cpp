@@ -1,0 +1,54 @@
+#include "optimizer/designs.hpp"
+
+#include <chrono>
+#include <limits>
+
+#include "optimizer/evaluation.hpp"
+
+namespace beamrail {
+
+DesignEvaluator::DesignEvaluator(const Study& study) : study_(study), base_(study.document) {
+  base_.erase("study");
+  for (const DesignVariable& v : study.design->variables)
+    pointers_.emplace_back(v.pointers.begin(), v.pointers.end());
+}
+
+Json DesignEvaluator::document(const std::vector<double>& x) const {
+  Json doc = base_;
+  const auto& variables = study_.design->variables;
+  for (size_t i = 0; i < pointers_.size(); ++i)
+    for (size_t k = 0; k < pointers_[i].size(); ++k)
+      doc[pointers_[i][k]] = variables[i].factors[k] * x[i];
+  return doc;
+}
+
+DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x) const {
+  const auto start = std::chrono::steady_clock::now();
+  DesignOutcome out;
+  out.responses.assign(study_.responses.size(), std::numeric_limits<double>::quiet_NaN());
+  try {
+    Diagnostics diag;
+    const auto design = load_study(document(x), study_.file, study_.directory, diag);
+    if (!design) {
+      // The first problem names what the values broke (zero-length beam, point on the axis...).
+      out.status = "invalid";
+      for (const Diagnostic& d : diag.items()) {
+        if (!out.message.empty()) out.message += "; ";
+        out.message += d.pointer + ": " + d.message;
+      }
+    } else {
+      const Evaluation ev = beamrail::evaluate(*design, design->model, EvaluationOptions{});
+      out.status = ev.status;
+      out.message = ev.message;
+      out.responses = ev.responses;
+    }
+  } catch (const std::exception& e) {
+    out.status = "failed";
+    out.message = e.what();
+  }
+  out.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace beamrail

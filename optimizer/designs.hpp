@@ -1,0 +1,40 @@
+// Evaluating designs: the study with its design variables set to given values is rebuilt,
+// re-validated and run. Each call builds its own Model and Data, so designs evaluate in parallel
+// without locks.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "optimizer/study.hpp"
+
+namespace beamrail {
+
+struct DesignOutcome {
+  std::string status = "ok";  // ok | failed | invalid
+  std::string message;
+  std::vector<double> responses;  // one per study.responses (NaN when not computed)
+  double wall_seconds = 0.0;
+};
+
+class DesignEvaluator {
+ public:
+  explicit DesignEvaluator(const Study& study);
+
+  // Thread-safe: reads only the evaluator's constant state.
+  DesignOutcome evaluate(const std::vector<double>& x) const;
+
+  // The study document with the variables set to x and no design study: a study that
+  // `beamrail run` runs as is.
+  Json document(const std::vector<double>& x) const;
+
+  const Study& study() const { return study_; }
+  size_t n_variables() const { return study_.design->variables.size(); }
+
+ private:
+  const Study& study_;
+  Json base_;                                              // study.document without "study"
+  std::vector<std::vector<Json::json_pointer>> pointers_;  // per variable
+};
+
+}  // namespace beamrail

@@ -1,0 +1,468 @@
+#include "optimizer/optimize.hpp"
+
+#include <nlopt.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <mutex>
+
+#include "optimizer/batch_table.hpp"
+#include "optimizer/designs.hpp"
+#include "optimizer/progress.hpp"
+#include "optimizer/sampling.hpp"
+#include "optimizer/summary.hpp"
+#include "optimizer/tables.hpp"
+#include "optimizer/version.hpp"
+
+namespace beamrail {
+namespace {
+
+// Objective and constraint values given to NLopt for a design that failed or is invalid.
+constexpr double kPenalty = 1e30;
+// A constraint counts as met up to this fraction of its bound.
+constexpr double kFeasibility = 1e-9;
+
+bool needs_gradient(const std::string& algorithm) {
+  return algorithm.size() > 2 && algorithm[1] == 'D';
+}
+
+bool handles_constraints(nlopt_algorithm a) {
+  switch (a) {
+    case NLOPT_LN_COBYLA:
+    case NLOPT_LD_MMA:
+    case NLOPT_LD_CCSAQ:
+    case NLOPT_LD_SLSQP:
+    case NLOPT_GN_ISRES:
+    case NLOPT_GN_ORIG_DIRECT:
+    case NLOPT_GN_ORIG_DIRECT_L:
+    case NLOPT_GN_AGS:
+    case NLOPT_AUGLAG:
+    case NLOPT_LN_AUGLAG:
+    case NLOPT_LD_AUGLAG:
+      return true;
+    default:
+      return false;
+  }
+}
+
+bool needs_local_optimizer(nlopt_algorithm a) {
+  return a == NLOPT_AUGLAG || a == NLOPT_AUGLAG_EQ || a == NLOPT_G_MLSL || a == NLOPT_G_MLSL_LDS;
+}
+
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+
+struct Record {
+  int start = 0, evaluation = 0;
+  Design x;
+  DesignOutcome outcome;
+  double objective = kPenalty;
+  bool feasible = false;
+};
+
+class Optimization {
+ public:
+  Optimization(const Study& study, const RunSettings& settings)
+      : study_(study),
+        plan_(study.design->optimize),
+        variables_(study.design->variables),
+        evaluator_(study),
+        settings_(settings),
+        progress_(static_cast<long>(plan_.max_evaluations) * plan_.starts, settings.quiet) {}
+
+  int run();
+
+ private:
+  struct Start {
+    Optimization* self = nullptr;
+    int index = 0;                  // 1-based
+    std::map<Design, int> numbers;  // distinct designs of this start -> evaluation number
+    std::string result;             // NLopt's return code
+    int nlopt_evaluations = 0;
+  };
+  struct ConstraintRef {
+    Start* start;
+    int j;
+  };
+
+  double objective_of(const DesignOutcome& o) const;
+  double constraint_of(const DesignOutcome& o, int j) const;
+  bool feasible(const DesignOutcome& o) const;
+
+  // The outcomes of designs xs for a start, evaluated in parallel where new, recorded in order.
+  std::vector<DesignOutcome> outcomes(Start& start, const std::vector<Design>& xs, bool parallel);
+  // Value and (when grad != nullptr) central-difference gradient of f(outcome) at x.
+  template <class F>
+  double value_and_gradient(Start& start, const double* x, double* grad, F&& f);
+
+  static double objective_callback(unsigned n, const double* x, double* grad, void* data);
+  static double constraint_callback(unsigned n, const double* x, double* grad, void* data);
+
+  void run_start(Start& start, const Design& x0);
+  std::vector<Design> start_points() const;
+  CsvRow row(const Record& r) const;
+  int report(const Record* best, const std::vector<Start>& starts, double wall) const;
+
+  const Study& study_;
+  const OptimizePlan& plan_;
+  const std::vector<DesignVariable>& variables_;
+  DesignEvaluator evaluator_;
+  const RunSettings& settings_;
+  Progress progress_;
+  BatchTable history_;
+  std::map<Design, DesignOutcome> cache_;  // every design evaluated, this run or before
+  std::vector<Record> records_;
+  std::mutex mutex_;
+  std::atomic<long> simulated_{0}, failures_{0};
+  int threads_ = 1;
+};
+
+double Optimization::objective_of(const DesignOutcome& o) const {
+  if (o.status != "ok") return kPenalty;
+  double f = 0.0;
+  switch (plan_.goal) {
+    case OptimizePlan::Goal::kMinimize:
+      f = o.responses[plan_.response];
+      break;
+    case OptimizePlan::Goal::kMaximize:
+      f = -o.responses[plan_.response];
+      break;
+    case OptimizePlan::Goal::kTarget:
+      for (const auto& [k, t] : plan_.targets) {
+        const double scale = t != 0.0 ? std::abs(t) : 1.0;
+        f += std::pow((o.responses[k] - t) / scale, 2);
+      }
+      break;
+  }
+  return std::isfinite(f) ? f : kPenalty;
+}
+
+double Optimization::constraint_of(const DesignOutcome& o, int j) const {
+  const Constraint& c = plan_.constraints[j];
+  const double r = o.responses[c.response];
+  if (o.status != "ok" || !std::isfinite(r)) return kPenalty;
+  const double scale = c.bound != 0.0 ? std::abs(c.bound) : 1.0;
+  switch (c.kind) {
+    case Constraint::Kind::kAtLeast:
+      return (c.bound - r) / scale;
+    case Constraint::Kind::kAtMost:
+      return (r - c.bound) / scale;
+    default:
+      return (std::abs(r) - c.bound) / scale;
+  }
+}
+
+bool Optimization::feasible(const DesignOutcome& o) const {
+  if (o.status != "ok" || objective_of(o) >= kPenalty) return false;
+  for (size_t j = 0; j < plan_.constraints.size(); ++j)
+    if (!(constraint_of(o, static_cast<int>(j)) <= kFeasibility)) return false;
+  return true;
+}
+
+CsvRow Optimization::row(const Record& r) const {
+  CsvRow out{std::to_string(r.start), std::to_string(r.evaluation)};
+  for (double x : r.x) out.push_back(format_number(x));
+  for (double v : r.outcome.responses) out.push_back(format_number(v));
+  out.push_back(format_number(r.objective));
+  out.push_back(r.feasible ? "1" : "0");
+  out.push_back(r.outcome.status);
+  out.push_back(format_number(r.outcome.wall_seconds));
+  out.push_back(one_line(r.outcome.message));
+  return out;
+}
+
+std::vector<DesignOutcome> Optimization::outcomes(Start& start, const std::vector<Design>& xs,
+                                                  bool parallel) {
+  std::vector<DesignOutcome> out(xs.size());
+  std::vector<char> known(xs.size(), 0);
+  std::vector<int> numbers(xs.size());
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (size_t i = 0; i < xs.size(); ++i) {
+      auto [it, fresh] =
+          start.numbers.try_emplace(xs[i], static_cast<int>(start.numbers.size()) + 1);
+      numbers[i] = fresh ? it->second : -it->second;  // negative: this start has its row already
+      const auto c = cache_.find(xs[i]);
+      if (c != cache_.end()) out[i] = c->second, known[i] = 1;
+    }
+  }
+  const long n = static_cast<long>(xs.size());
+#pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1) num_threads(threads_)
+  for (long i = 0; i < n; ++i)
+    if (!known[i]) {
+      out[i] = evaluator_.evaluate(xs[i]);
+      ++simulated_;
+      if (out[i].status != "ok") ++failures_;
+    }
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (size_t i = 0; i < xs.size(); ++i) {
+    cache_.try_emplace(xs[i], out[i]);
+    if (numbers[i] < 0) continue;
+    Record r{start.index, numbers[i], xs[i], out[i], objective_of(out[i]), feasible(out[i])};
+    history_.append(row(r));
+    records_.push_back(std::move(r));
+  }
+  return out;
+}
+
+template <class F>
+double Optimization::value_and_gradient(Start& start, const double* x, double* grad, F&& f) {
+  const size_t n = variables_.size();
+  const Design x0(x, x + n);
+  std::vector<Design> points{x0};
+  std::vector<double> h(n, 0.0);
+  if (grad) {
+    for (size_t i = 0; i < n; ++i) {
+      h[i] = plan_.gradient_step * (variables_[i].upper - variables_[i].lower);
+      Design up = x0, down = x0;
+      up[i] = std::min(x0[i] + h[i], variables_[i].upper);
+      down[i] = std::max(x0[i] - h[i], variables_[i].lower);
+      points.push_back(up);
+      points.push_back(down);
+    }
+  }
+  const std::vector<DesignOutcome> o = outcomes(start, points, true);
+  const double value = f(o[0]);
+  if (grad)
+    for (size_t i = 0; i < n; ++i) {
+      const double fu = f(o[1 + 2 * i]), fd = f(o[2 + 2 * i]);
+      const double xu = points[1 + 2 * i][i], xd = points[2 + 2 * i][i];
+      if (fu < kPenalty && fd < kPenalty)
+        grad[i] = (fu - fd) / (xu - xd);
+      else if (fu < kPenalty && value < kPenalty && xu != x0[i])
+        grad[i] = (fu - value) / (xu - x0[i]);
+      else if (fd < kPenalty && value < kPenalty && xd != x0[i])
+        grad[i] = (value - fd) / (x0[i] - xd);
+      else
+        grad[i] = 0.0;
+    }
+  return value;
+}
+
+double Optimization::objective_callback(unsigned, const double* x, double* grad, void* data) {
+  auto* start = static_cast<Start*>(data);
+  try {
+    ++start->nlopt_evaluations;
+    Optimization& self = *start->self;
+    const double v = self.value_and_gradient(
+        *start, x, grad, [&](const DesignOutcome& o) { return self.objective_of(o); });
+    std::string best;
+    self.progress_.update(self.simulated_, self.failures_, best);
+    return v;
+  } catch (...) {
+    return kPenalty;  // never throw through NLopt
+  }
+}
+
+double Optimization::constraint_callback(unsigned, const double* x, double* grad, void* data) {
+  auto* ref = static_cast<ConstraintRef*>(data);
+  try {
+    Optimization& self = *ref->start->self;
+    const int j = ref->j;
+    return self.value_and_gradient(
+        *ref->start, x, grad, [&](const DesignOutcome& o) { return self.constraint_of(o, j); });
+  } catch (...) {
+    return kPenalty;
+  }
+}
+
+std::vector<Design> Optimization::start_points() const {
+  std::vector<Design> points;
+  bool all_initial = true;
+  Design initial;
+  for (const DesignVariable& v : variables_) {
+    all_initial = all_initial && v.initial.has_value();
+    initial.push_back(v.initial.value_or(0.5 * (v.lower + v.upper)));
+  }
+  if (all_initial) points.push_back(initial);
+  const int more = plan_.starts - static_cast<int>(points.size());
+  if (more > 0)
+    for (Design& d : latin_hypercube(variables_, more, plan_.seed)) points.push_back(d);
+  return points;
+}
+
+void Optimization::run_start(Start& start, const Design& x0) {
+  const unsigned n = static_cast<unsigned>(variables_.size());
+  const nlopt_algorithm algorithm = nlopt_algorithm_from_string(plan_.algorithm.c_str());
+  const bool gradient = needs_gradient(plan_.algorithm);
+  std::vector<nlopt_opt> owned;
+  const auto local_optimizer = [&](nlopt_opt outer, nlopt_algorithm a) {
+    nlopt_opt local = nlopt_create(a, n);
+    nlopt_set_xtol_rel(local, plan_.xtol_rel);
+    nlopt_set_ftol_rel(local, plan_.ftol_rel);
+    nlopt_set_local_optimizer(outer, local);
+    owned.push_back(local);
+  };
+  nlopt_opt opt = nullptr;
+  if (!plan_.constraints.empty() && !handles_constraints(algorithm)) {
+    // Algorithms without constraint support run inside an augmented Lagrangian.
+    opt = nlopt_create(gradient ? NLOPT_LD_AUGLAG : NLOPT_LN_AUGLAG, n);
+    local_optimizer(opt, algorithm);
+  } else {
+    opt = nlopt_create(algorithm, n);
+    if (needs_local_optimizer(algorithm) || plan_.algorithm.find("MLSL") != std::string::npos) {
+      const std::string name = !plan_.local_algorithm.empty() ? plan_.local_algorithm
+                               : gradient                     ? "LD_MMA"
+                                                              : "LN_COBYLA";
+      local_optimizer(opt, nlopt_algorithm_from_string(name.c_str()));
+    }
+  }
+  owned.push_back(opt);
+  std::vector<double> lower, upper;
+  for (const DesignVariable& v : variables_) lower.push_back(v.lower), upper.push_back(v.upper);
+  nlopt_set_lower_bounds(opt, lower.data());
+  nlopt_set_upper_bounds(opt, upper.data());
+  nlopt_set_min_objective(opt, objective_callback, &start);
+  std::vector<ConstraintRef> refs;
+  for (size_t j = 0; j < plan_.constraints.size(); ++j)
+    refs.push_back(ConstraintRef{&start, static_cast<int>(j)});
+  for (ConstraintRef& ref : refs)
+    nlopt_add_inequality_constraint(opt, constraint_callback, &ref, 1e-8);
+  nlopt_set_xtol_rel(opt, plan_.xtol_rel);
+  nlopt_set_ftol_rel(opt, plan_.ftol_rel);
+  nlopt_set_maxeval(opt, plan_.max_evaluations);
+  if (plan_.max_seconds > 0) nlopt_set_maxtime(opt, plan_.max_seconds);
+  nlopt_srand(plan_.seed + static_cast<unsigned long>(start.index));  // stochastic algorithms
+
+  Design x = x0;
+  double f = 0.0;
+  const nlopt_result result = nlopt_optimize(opt, x.data(), &f);
+  start.result = nlopt_result_to_string(result);
+  for (nlopt_opt o : owned) nlopt_destroy(o);
+}
+
+int Optimization::report(const Record* best, const std::vector<Start>& starts, double wall) const {
+  nlohmann::json s;
+  s["study"] = study_.name;
+  s["file"] = study_.file;
+  s["beamrail_version"] = kVersion;
+  s["type"] = "optimize";
+  s["algorithm"] = plan_.algorithm;
+  s["status"] = best ? "ok" : "infeasible";
+  s["message"] = best ? "" : "no evaluated design satisfies every constraint";
+  nlohmann::json per_start = nlohmann::json::array();
+  for (const Start& st : starts)
+    per_start.push_back({{"start", st.index},
+                         {"nlopt_result", st.result},
+                         {"nlopt_evaluations", st.nlopt_evaluations},
+                         {"designs", st.numbers.size()}});
+  s["starts"] = per_start;
+  s["designs_simulated"] = simulated_.load();
+  s["designs_failed"] = failures_.load();
+  s["designs_in_history"] = records_.size();
+  s["threads"] = threads_;
+  s["wall_seconds"] = wall;
+  s["evaluations_per_second"] = wall > 0 ? static_cast<double>(simulated_.load()) / wall : 0.0;
+  s["model"] = model_summary(study_.model);
+  std::string error;
+  bool ok = true;
+  if (best) {
+    nlohmann::json b;
+    b["objective"] = json_number(best->objective);
+    b["start"] = best->start;
+    b["evaluation"] = best->evaluation;
+    nlohmann::json vars = nlohmann::json::object(), resp = nlohmann::json::object();
+    for (size_t i = 0; i < variables_.size(); ++i) vars[variables_[i].name] = best->x[i];
+    for (size_t k = 0; k < study_.responses.size(); ++k)
+      resp[study_.responses[k].name] = json_number(best->outcome.responses[k]);
+    b["variables"] = vars;
+    b["responses"] = resp;
+    s["best"] = b;
+    s["responses"] = resp;
+    Json scene = evaluator_.document(best->x);
+    scene["name"] = study_.name + "_best";
+    scene["description"] = "The best design found by " + plan_.algorithm + " for study \"" +
+                           study_.name + "\" (start " + std::to_string(best->start) +
+                           ", evaluation " + std::to_string(best->evaluation) + ").";
+    ok = write_file_atomically(settings_.output / "best.json", b.dump(2) + "\n", &error) &&
+         write_file_atomically(settings_.output / "best_scene.json", scene.dump(2) + "\n", &error);
+  }
+  ok = ok && write_file_atomically(settings_.output / "summary.json", s.dump(2) + "\n", &error);
+  if (!ok) {
+    std::cerr << "beamrail: " << error << "\n";
+    return 1;
+  }
+  if (!best) {
+    std::cerr << "beamrail: " << study_.name << ": no feasible design found (" << records_.size()
+              << " designs evaluated); see " << settings_.output.string() << "/history.csv\n";
+    return 1;
+  }
+  std::cout << study_.name << ": best objective " << format_number(best->objective) << " at";
+  for (size_t i = 0; i < variables_.size(); ++i)
+    std::cout << " " << variables_[i].name << " = " << format_number(best->x[i]);
+  std::cout << " (" << records_.size() << " designs, " << wall << " s) -> "
+            << settings_.output.string() << "\n";
+  return 0;
+}
+
+int Optimization::run() {
+  const auto wall_start = std::chrono::steady_clock::now();
+  CsvRow header{"start", "evaluation"};
+  for (const DesignVariable& v : variables_) header.push_back(v.name);
+  for (const ResponseSpec& r : study_.responses) header.push_back(r.name);
+  for (const char* c : {"objective", "feasible", "status", "wall_s", "message"})
+    header.push_back(c);
+  std::vector<CsvRow> existing;
+  std::string error;
+  if (!history_.open(settings_.output / "history.csv", header, settings_.resume, &existing,
+                     &error)) {
+    std::cerr << "beamrail: " << error << "\n";
+    return 2;
+  }
+  // Earlier evaluations become the cache that NLopt's replayed path hits.
+  const size_t nv = variables_.size(), nr = study_.responses.size();
+  for (const CsvRow& r : existing) {
+    Design x;
+    for (size_t i = 0; i < nv; ++i) x.push_back(std::strtod(r[2 + i].c_str(), nullptr));
+    DesignOutcome o;
+    for (size_t k = 0; k < nr; ++k)
+      o.responses.push_back(std::strtod(r[2 + nv + k].c_str(), nullptr));
+    o.status = r[2 + nv + nr + 2];
+    o.wall_seconds = std::strtod(r[2 + nv + nr + 3].c_str(), nullptr);
+    o.message = r[2 + nv + nr + 4];
+    cache_.try_emplace(x, o);
+  }
+
+  threads_ = settings_.threads > 0 ? settings_.threads : omp_get_num_procs();
+  const std::vector<Design> points = start_points();
+  std::vector<Start> starts(points.size());
+  for (size_t s = 0; s < points.size(); ++s)
+    starts[s].self = this, starts[s].index = static_cast<int>(s) + 1;
+  const int n_starts = static_cast<int>(points.size());
+#pragma omp parallel for schedule(dynamic, 1) if (n_starts > 1) \
+    num_threads(std::min(threads_, n_starts))
+  for (int s = 0; s < n_starts; ++s) run_start(starts[s], points[s]);
+
+  if (!history_.finalize({0, 1}, &error)) {
+    std::cerr << "beamrail: " << error << "\n";
+    return 1;
+  }
+  // The best feasible design; ties go to the earliest (start, evaluation).
+  const Record* best = nullptr;
+  std::sort(records_.begin(), records_.end(), [](const Record& a, const Record& b) {
+    return std::tie(a.start, a.evaluation) < std::tie(b.start, b.evaluation);
+  });
+  for (const Record& r : records_)
+    if (r.feasible && (!best || r.objective < best->objective)) best = &r;
+  return report(
+      best, starts,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
+}
+
+}  // namespace
+
+int run_optimize(const Study& study, const RunSettings& settings) {
+  Optimization o(study, settings);
+  return o.run();
+}
+
+}  // namespace beamrail

@@ -85,10 +85,13 @@ bool BatchTable::open(const std::filesystem::path& path, const CsvRow& header, b
   header_ = header;
   existing->clear();
   std::error_code ec;
-  if (resume && std::filesystem::exists(path, ec)) {
-    size_t whole = 0;
-    const std::vector<std::string> lines = whole_lines(path, &whole);
-    if (lines.empty() || parse_csv_line(lines.front()) != header) {
+  size_t whole = 0;
+  // A run killed before its header reached the file leaves no whole line: start afresh.
+  const std::vector<std::string> lines = resume && std::filesystem::exists(path, ec)
+                                             ? whole_lines(path, &whole)
+                                             : std::vector<std::string>{};
+  if (!lines.empty()) {
+    if (parse_csv_line(lines.front()) != header) {
       *error = "cannot resume: " + path.string() +
                " was written by a different study (its columns differ); remove it or run "
                "without --resume";

@@ -1,0 +1,653 @@
+// Design studies through the real command line (SPEC.md "study", "Outputs"): the optimizer finds a
+// closed-form optimum, sweep rows equal single runs of the same designs, tables do not depend on
+// the number of threads, interrupted runs (truncated tables, SIGKILL) resume to the uninterrupted
+// result, designs that break the scene or the analysis become rows with a status, and design
+// variables that address no number are bad input.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <random>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/support/run_process.hpp"
+
+#ifndef BEAMRAIL_EXECUTABLE
+#error "BEAMRAIL_EXECUTABLE must name the beamrail binary"
+#endif
+#ifndef BEAMRAIL_STUDIES_DIR
+#error "BEAMRAIL_STUDIES_DIR must name the studies/ directory"
+#endif
+
+namespace beamrail {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using Pointer = Json::json_pointer;
+using beamrail::testing::ProcessResult;
+using beamrail::testing::read_text;
+
+const fs::path kStudies = BEAMRAIL_STUDIES_DIR;
+
+Json load_json(const fs::path& path) { return Json::parse(read_text(path)); }
+
+void save_text(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+void save_json(const fs::path& path, const Json& json) { save_text(path, json.dump(2) + "\n"); }
+
+std::string g17(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+// --- CSV, read independently of the program's own reader ----------------------------------------
+
+// The fields of one line as written (quotes kept), split at commas outside quotes.
+std::vector<std::string> raw_fields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') quoted = !quoted;  // a doubled quote toggles twice
+    if (c == ',' && !quoted)
+      out.emplace_back();
+    else
+      out.back() += c;
+  }
+  return out;
+}
+
+std::string unquote(const std::string& raw) {
+  if (raw.size() < 2 || raw.front() != '"') return raw;
+  std::string out;
+  for (size_t i = 1; i + 1 < raw.size(); ++i) {
+    out += raw[i];
+    if (raw[i] == '"') ++i;
+  }
+  return out;
+}
+
+// Lines without their newlines; *whole is false when the text does not end with one.
+std::vector<std::string> lines_of(const std::string& text, bool* whole = nullptr) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  for (size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '\n') lines.push_back(text.substr(start, i - start)), start = i + 1;
+  if (start < text.size()) lines.push_back(text.substr(start));
+  if (whole) *whole = text.empty() || text.back() == '\n';
+  return lines;
+}
+
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  int column(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+  }
+  const std::string& at(size_t row, const std::string& name) const {
+    return rows.at(row).at(column(name));
+  }
+};
+
+Table read_table(const fs::path& path) {
+  Table t;
+  const std::vector<std::string> lines = lines_of(read_text(path));
+  for (size_t i = 0; i < lines.size(); ++i) {
+    std::vector<std::string> fields;
+    for (const std::string& f : raw_fields(lines[i])) fields.push_back(unquote(f));
+    if (i == 0)
+      t.header = fields;
+    else
+      t.rows.push_back(fields);
+  }
+  return t;
+}
+
+// The table text with the named column's fields emptied (header kept), every other byte as is.
+std::string without_column(const std::string& text, const std::string& name) {
+  bool whole = true;
+  const std::vector<std::string> lines = lines_of(text, &whole);
+  if (lines.empty()) return text;
+  const std::vector<std::string> header = raw_fields(lines[0]);
+  const auto it = std::find(header.begin(), header.end(), name);
+  if (it == header.end()) {
+    ADD_FAILURE() << "no column \"" << name << "\" in " << lines[0];
+    return text;
+  }
+  const size_t column = static_cast<size_t>(it - header.begin());
+  std::string out;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    std::vector<std::string> fields = raw_fields(lines[i]);
+    if (i > 0 && column < fields.size()) fields[column].clear();
+    for (size_t k = 0; k < fields.size(); ++k) out += (k ? "," : "") + fields[k];
+    if (i + 1 < lines.size() || whole) out += '\n';
+  }
+  return out;
+}
+
+// Text equality with the first differing line in the message.
+::testing::AssertionResult SameText(const std::string& a, const std::string& b) {
+  if (a == b) return ::testing::AssertionSuccess();
+  const std::vector<std::string> la = lines_of(a), lb = lines_of(b);
+  for (size_t i = 0; i < std::max(la.size(), lb.size()); ++i) {
+    const std::string x = i < la.size() ? la[i] : "<none>", y = i < lb.size() ? lb[i] : "<none>";
+    if (x != y)
+      return ::testing::AssertionFailure()
+             << "line " << i + 1 << " differs (" << la.size() << " vs " << lb.size()
+             << " lines):\n  " << x << "\n  " << y;
+  }
+  return ::testing::AssertionFailure() << "the texts differ in their last newline";
+}
+
+uint64_t bits(double x) { return std::bit_cast<uint64_t>(x); }
+
+// --- Fixture ------------------------------------------------------------------------------------
+
+class DesignStudyRuns : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "beamrail_design_study_XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  ProcessResult run(const std::vector<std::string>& args) {
+    return beamrail::testing::run_process(BEAMRAIL_EXECUTABLE, args, dir_);
+  }
+
+  // `beamrail run study -o out --quiet [extra]`, which must exit 0.
+  void run_ok(const fs::path& study, const std::string& out,
+              const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args{"run", study.string(), "-o", out, "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const ProcessResult r = run(args);
+    ASSERT_TRUE(r.exited && r.status == 0)
+        << "beamrail run " << study.string() << " -o " << out << ": " << r.how << "\n"
+        << r.err;
+  }
+
+  fs::path write_study(const std::string& name, const Json& study) {
+    save_json(dir_ / name, study);
+    return dir_ / name;
+  }
+
+  fs::path dir_;
+};
+
+// The tube cantilever sweep with an n_d x n_w grid (outer diameter 20..60 mm, wall 1..5 mm) and,
+// when segments > 0, a segmented (slower) beam.
+Json tube_grid(int n_d, int n_w, int segments = 0) {
+  Json s = load_json(kStudies / "tube_cantilever_sweep.json");
+  Json& v = s["study"]["variables"];
+  v[0]["count"] = n_d;
+  v[1] = Json{{"name", "wall"},
+              {"pointer", "/scene/sections/tube/wall"},
+              {"lower", 0.001},
+              {"upper", 0.005},
+              {"count", n_w}};
+  if (segments > 0) s["scene"]["beams"][0]["segments"] = segments;
+  return s;
+}
+
+// --- 1. Closed-form optimum ---------------------------------------------------------------------
+
+// min_mass_rod: a massless solid rod cantilever (length L) carrying a tip body (mass m, rotary
+// inertia J about the bending axis, centre of mass at the beam tip). Its first bending frequency
+// comes from the 2 x 2 tip problem EI Khat x = w^2 diag(m, J) x with
+// Khat = [[12/L^3, -6/L^2], [-6/L^2, 4/L]]: w1^2 = EI c, c the smallest generalized eigenvalue.
+// With I = pi d^4 / 64 and the mass m + rho pi d^2 L / 4 increasing with d, the lightest rod has
+// f1 = 20 Hz exactly: d* = (64 (2 pi 20)^2 / (pi E c))^(1/4).
+TEST_F(DesignStudyRuns, MinimumMassRodReachesTheClosedFormOptimum) {
+  const Json study = load_json(kStudies / "min_mass_rod.json");
+  const Json& scene = study["scene"];
+  const double E = scene["materials"]["steel"]["E"], rho = scene["materials"]["steel"]["density"];
+  const Json& tip = scene["bodies"][0];
+  const Json& rod = scene["beams"][0];
+  const double m = tip["mass"], J = tip["inertia"][2];
+  // The closed form's assumptions, as the study states them.
+  ASSERT_EQ(scene["bodies"].size(), 1u);
+  ASSERT_EQ(scene["beams"].size(), 1u);
+  ASSERT_EQ(tip["inertia"], Json({J, J, J}));
+  ASSERT_EQ(tip["position"], rod["point2"]);
+  ASSERT_EQ(rod["point1"], Json({0, 0, 0}));
+  ASSERT_EQ(rod.value("segments", 0), 0);
+  ASSERT_EQ(study["study"]["constraints"], Json::parse(R"([{"response": "f1", ">=": 20.0}])"));
+  ASSERT_EQ(study["study"]["variables"][0]["pointer"], "/scene/sections/rod/diameter");
+  const double L = rod["point2"][0];
+  EXPECT_EQ(L, 1.0);
+  EXPECT_EQ(E, 2.1e11);
+  EXPECT_EQ(m, 2.0);
+  EXPECT_EQ(J, 1e-3);
+
+  Eigen::Matrix2d K, M;
+  K << 12 / (L * L * L), -6 / (L * L), -6 / (L * L), 4 / L;
+  M << m, 0, 0, J;
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> solver(K, M);
+  ASSERT_EQ(solver.info(), Eigen::Success);
+  const double c = solver.eigenvalues()(0);  // ascending
+  const double w = 2 * M_PI * 20.0;
+  const double d_star = std::pow(64 * w * w / (M_PI * E * c), 0.25);
+  std::printf("closed form: c = %s, d* = %s m\n", g17(c).c_str(), g17(d_star).c_str());
+
+  for (const std::string algorithm : {"LN_COBYLA", "LD_SLSQP"}) {
+    SCOPED_TRACE(algorithm);
+    fs::path file = kStudies / "min_mass_rod.json";
+    if (algorithm != study["study"]["algorithm"]) {
+      Json copy = study;
+      copy["study"]["algorithm"] = algorithm;
+      file = write_study("min_mass_rod_" + algorithm + ".json", copy);
+    }
+    const std::string out = "out_" + algorithm;
+    ASSERT_NO_FATAL_FAILURE(run_ok(file, out));
+    const Json best = load_json(dir_ / out / "best.json");
+    const Json summary = load_json(dir_ / out / "summary.json");
+    const double d = best["variables"]["d"], f1 = best["responses"]["f1"],
+                 mass = best["responses"]["mass"];
+    const double mass_formula = m + rho * M_PI * d * d * L / 4;
+    const double f1_formula = std::sqrt(E * M_PI * std::pow(d, 4) / 64 * c) / (2 * M_PI);
+    std::printf(
+        "%s: d = %s (d/d* - 1 = %.3g), f1 = %s (f1/f1(d) - 1 = %.3g), mass = %s (vs formula %.3g), "
+        "designs simulated %d, NLopt evaluations %d, result %s\n",
+        algorithm.c_str(), g17(d).c_str(), d / d_star - 1, g17(f1).c_str(), f1 / f1_formula - 1,
+        g17(mass).c_str(), mass / mass_formula - 1, summary["designs_simulated"].get<int>(),
+        summary["starts"][0]["nlopt_evaluations"].get<int>(),
+        summary["starts"][0]["nlopt_result"].get<std::string>().c_str());
+    EXPECT_EQ(summary["status"], "ok");
+    EXPECT_NEAR(d / d_star - 1, 0.0, 1e-6);
+    EXPECT_GE(f1, 20.0 * (1 - 1e-9));
+    EXPECT_NEAR(mass / mass_formula - 1, 0.0, 1e-9);
+    EXPECT_NEAR(f1 / f1_formula - 1, 0.0, 1e-9);
+  }
+}
+
+// --- 2. Sweep rows equal single runs ------------------------------------------------------------
+
+TEST_F(DesignStudyRuns, SweepRowsEqualSingleRunsOfTheSameDesigns) {
+  Json study = load_json(kStudies / "tube_cantilever_sweep.json");
+  study["study"]["variables"][0]["count"] = 3;                       // 20, 40, 60 mm
+  study["study"]["variables"][1]["values"] = Json{0.0015, 0.00425};  // walls
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("grid.json", study), "grid"));
+  const Table t = read_table(dir_ / "grid" / "samples.csv");
+  ASSERT_EQ(t.rows.size(), 6u);
+  const Json& variables = study["study"]["variables"];
+  std::vector<std::string> responses;
+  for (const auto& item : study["responses"].items()) responses.push_back(item.key());
+
+  for (size_t row : {size_t{0}, size_t{3}, size_t{5}}) {
+    SCOPED_TRACE("row " + std::to_string(row));
+    ASSERT_EQ(t.at(row, "index"), std::to_string(row));
+    ASSERT_EQ(t.at(row, "status"), "ok");
+    Json single = study;
+    single.erase("study");
+    single["name"] = "single_" + std::to_string(row);
+    for (const Json& v : variables)
+      single[Pointer(v["pointer"].get<std::string>())] =
+          std::strtod(t.at(row, v["name"]).c_str(), nullptr);
+    const std::string out = "single_" + std::to_string(row);
+    ASSERT_NO_FATAL_FAILURE(run_ok(write_study(out + ".json", single), out));
+    const Json summary = load_json(dir_ / out / "summary.json");
+    std::printf("row %zu (d = %s, wall = %s):", row, t.at(row, "outer_diameter").c_str(),
+                t.at(row, "wall").c_str());
+    for (const std::string& name : responses) {
+      const double swept = std::strtod(t.at(row, name).c_str(), nullptr);
+      ASSERT_TRUE(summary["responses"][name].is_number()) << name << ": " << summary.dump(2);
+      const double alone = summary["responses"][name];
+      std::printf(" %s %s|%s", name.c_str(), t.at(row, name).c_str(), g17(alone).c_str());
+      EXPECT_EQ(bits(swept), bits(alone))
+          << name << ": sweep " << g17(swept) << ", single run " << g17(alone);
+    }
+    std::printf("\n");
+  }
+}
+
+// --- 3. Tables do not depend on the number of threads -------------------------------------------
+
+TEST_F(DesignStudyRuns, OneAndTwoThreadsGiveIdenticalTables) {
+  // A 30 x 30 sweep.
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("grid.json", tube_grid(30, 30)), "j1", {"-j", "1"}));
+  ASSERT_NO_FATAL_FAILURE(run_ok(dir_ / "grid.json", "j2", {"-j", "2"}));
+  const std::string s1 = read_text(dir_ / "j1" / "samples.csv"),
+                    s2 = read_text(dir_ / "j2" / "samples.csv");
+  std::printf("sweep: %zu lines, %zu bytes (-j 1), %zu bytes (-j 2)\n", lines_of(s1).size(),
+              s1.size(), s2.size());
+  EXPECT_EQ(lines_of(s1).size(), 901u);
+  EXPECT_TRUE(SameText(without_column(s1, "wall_s"), without_column(s2, "wall_s")));
+
+  // Optimizations: min_mass_rod with one gradient-based start (its finite-difference points
+  // evaluate in parallel) and with three (the starts run in parallel), and the portal frame (two
+  // COBYLA starts).
+  Json rod = load_json(kStudies / "min_mass_rod.json");
+  rod["study"]["algorithm"] = "LD_SLSQP";
+  const fs::path rod1 = write_study("rod1.json", rod);
+  rod["study"]["starts"] = 3;
+  const fs::path rod3 = write_study("rod3.json", rod);
+  for (const fs::path& file : {rod1, rod3, kStudies / "portal_frame_design.json"}) {
+    SCOPED_TRACE(file.string());
+    const std::string name = file.stem().string();
+    ASSERT_NO_FATAL_FAILURE(run_ok(file, name + "_j1", {"-j", "1"}));
+    ASSERT_NO_FATAL_FAILURE(run_ok(file, name + "_j2", {"-j", "2"}));
+    const fs::path a = dir_ / (name + "_j1"), b = dir_ / (name + "_j2");
+    const std::string h1 = read_text(a / "history.csv"), h2 = read_text(b / "history.csv");
+    const Json summary = load_json(b / "summary.json");
+    std::printf("%s: %zu history rows, %zu starts, best objective %s\n", name.c_str(),
+                lines_of(h1).size() - 1, summary["starts"].size(),
+                g17(summary["best"]["objective"]).c_str());
+    EXPECT_EQ(summary["starts"].size(), load_json(file)["study"].value("starts", 1));
+    EXPECT_TRUE(SameText(without_column(h1, "wall_s"), without_column(h2, "wall_s")));
+    EXPECT_TRUE(SameText(read_text(a / "best.json"), read_text(b / "best.json")));
+    EXPECT_TRUE(SameText(read_text(a / "best_scene.json"), read_text(b / "best_scene.json")));
+  }
+}
+
+// --- 4. Resume ----------------------------------------------------------------------------------
+
+// Whole rows only: every line has the header's column count and the file ends with a newline.
+::testing::AssertionResult WholeRows(const std::string& text, size_t* rows) {
+  bool whole = false;
+  const std::vector<std::string> lines = lines_of(text, &whole);
+  if (lines.empty() || !whole)
+    return ::testing::AssertionFailure()
+           << "empty or not ending with a newline: ..."
+           << text.substr(text.size() - std::min<size_t>(80, text.size()));
+  const size_t columns = raw_fields(lines[0]).size();
+  for (size_t i = 1; i < lines.size(); ++i)
+    if (raw_fields(lines[i]).size() != columns)
+      return ::testing::AssertionFailure()
+             << "line " << i + 1 << " has " << raw_fields(lines[i]).size() << " fields, not "
+             << columns << ": " << lines[i];
+  *rows = lines.size() - 1;
+  return ::testing::AssertionSuccess();
+}
+
+// Indices 0..n-1, each once, in order.
+::testing::AssertionResult IndicesInOrder(const fs::path& samples, size_t n) {
+  const Table t = read_table(samples);
+  if (t.rows.size() != n)
+    return ::testing::AssertionFailure() << t.rows.size() << " rows, expected " << n;
+  for (size_t i = 0; i < n; ++i)
+    if (t.at(i, "index") != std::to_string(i))
+      return ::testing::AssertionFailure() << "row " << i << " has index " << t.at(i, "index");
+  return ::testing::AssertionSuccess();
+}
+
+TEST_F(DesignStudyRuns, SweepResumesFromAShuffledSubsetOfRowsAndAPartialRow) {
+  const fs::path study = kStudies / "tube_cantilever_sweep.json";
+  ASSERT_NO_FATAL_FAILURE(run_ok(study, "out"));
+  const std::string reference = read_text(dir_ / "out" / "samples.csv");
+  const std::vector<std::string> lines = lines_of(reference);
+  const size_t n = lines.size() - 1;
+  ASSERT_EQ(n, 45u);
+
+  std::mt19937 rng(20240611);
+  std::vector<size_t> kept, missing;
+  for (size_t i = 1; i <= n; ++i) (rng() % 3 != 0 ? kept : missing).push_back(i);
+  std::shuffle(kept.begin(), kept.end(), rng);
+  ASSERT_FALSE(missing.empty());
+  std::string text = lines[0] + "\n";
+  for (size_t i : kept) text += lines[i] + "\n";
+  const std::string& cut = lines[missing[missing.size() / 2]];
+  text += cut.substr(0, cut.size() / 2);  // half a row, no newline
+  save_text(dir_ / "out" / "samples.csv", text);
+  fs::remove(dir_ / "out" / "summary.json");
+
+  ASSERT_NO_FATAL_FAILURE(run_ok(study, "out", {"--resume"}));
+  const std::string resumed = read_text(dir_ / "out" / "samples.csv");
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  std::printf(
+      "sweep resume: kept %zu shuffled rows + half a row, %zu missing; evaluated_now %d, "
+      "resumed_from_table %d\n",
+      kept.size(), missing.size(), summary["evaluated_now"].get<int>(),
+      summary["resumed_from_table"].get<int>());
+  EXPECT_TRUE(SameText(without_column(reference, "wall_s"), without_column(resumed, "wall_s")));
+  EXPECT_TRUE(IndicesInOrder(dir_ / "out" / "samples.csv", n));
+  EXPECT_EQ(summary["evaluated_now"], missing.size());
+  EXPECT_EQ(summary["resumed_from_table"], kept.size());
+  EXPECT_EQ(summary["designs"], n);
+}
+
+// A run killed between creating its table and writing the header leaves an empty file (or, in
+// principle, part of the header): --resume starts afresh instead of refusing the table.
+TEST_F(DesignStudyRuns, ResumeFromATableWithoutAWholeHeaderStartsAfresh) {
+  const struct {
+    fs::path study;
+    const char* table;
+  } cases[] = {{kStudies / "tube_cantilever_sweep.json", "samples.csv"},
+               {kStudies / "min_mass_rod.json", "history.csv"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.table);
+    ASSERT_NO_FATAL_FAILURE(run_ok(c.study, "ref"));
+    const std::string reference = read_text(dir_ / "ref" / c.table);
+    const std::string header = lines_of(reference).at(0);
+    for (const std::string& left : {std::string(), header.substr(0, header.size() / 2)}) {
+      fs::create_directories(dir_ / "out");
+      save_text(dir_ / "out" / c.table, left);
+      const ProcessResult r = run({"run", c.study.string(), "-o", "out", "--quiet", "--resume"});
+      std::printf("%s left with %zu bytes: --resume %s %s", c.table, left.size(), r.how.c_str(),
+                  r.err.c_str());
+      ASSERT_TRUE(r.exited && r.status == 0) << r.how << "\n" << r.err;
+      EXPECT_TRUE(SameText(without_column(reference, "wall_s"),
+                           without_column(read_text(dir_ / "out" / c.table), "wall_s")));
+      fs::remove_all(dir_ / "out");
+    }
+    std::printf("\n");
+    fs::remove_all(dir_ / "ref");
+  }
+}
+
+TEST_F(DesignStudyRuns, OptimizationResumesFromHalfItsHistory) {
+  Json rod3 = load_json(kStudies / "min_mass_rod.json");
+  rod3["study"]["algorithm"] = "LD_SLSQP";
+  rod3["study"]["starts"] = 3;
+  const fs::path files[] = {kStudies / "min_mass_rod.json", write_study("rod3.json", rod3)};
+  for (const fs::path& file : files) {
+    SCOPED_TRACE(file.string());
+    const bool single_start = file == files[0];
+    ASSERT_NO_FATAL_FAILURE(run_ok(file, "ref"));
+    const std::string reference = read_text(dir_ / "ref" / "history.csv");
+    const Json ref_summary = load_json(dir_ / "ref" / "summary.json");
+    const std::vector<std::string> lines = lines_of(reference);
+    const size_t rows = lines.size() - 1, kept = rows / 2;
+    ASSERT_GE(rows, 6u);
+
+    fs::create_directories(dir_ / "out");
+    std::string text;
+    for (size_t i = 0; i <= kept; ++i) text += lines[i] + "\n";
+    text += lines[kept + 1].substr(0, lines[kept + 1].size() / 2);
+    save_text(dir_ / "out" / "history.csv", text);
+    ASSERT_NO_FATAL_FAILURE(run_ok(file, "out", {"--resume", "-j", "2"}));
+    const Json summary = load_json(dir_ / "out" / "summary.json");
+    const long simulated = summary["designs_simulated"],
+               ref_simulated = ref_summary["designs_simulated"];
+    std::printf(
+        "%s: reference %zu rows, %ld designs simulated; resumed from %zu rows + half a row, "
+        "%ld designs simulated\n",
+        file.stem().c_str(), rows, ref_simulated, kept, simulated);
+    EXPECT_TRUE(SameText(without_column(reference, "wall_s"),
+                         without_column(read_text(dir_ / "out" / "history.csv"), "wall_s")));
+    EXPECT_TRUE(
+        SameText(read_text(dir_ / "ref" / "best.json"), read_text(dir_ / "out" / "best.json")));
+    EXPECT_TRUE(SameText(read_text(dir_ / "ref" / "best_scene.json"),
+                         read_text(dir_ / "out" / "best_scene.json")));
+    // Each row's design is simulated once at most; the kept rows are not simulated again.
+    EXPECT_GT(simulated, 0);
+    EXPECT_LT(simulated, ref_simulated);
+    EXPECT_LE(simulated, static_cast<long>(rows - kept));
+    if (single_start) {
+      EXPECT_EQ(simulated, static_cast<long>(rows - kept));
+    }
+    fs::remove_all(dir_ / "ref");
+    fs::remove_all(dir_ / "out");
+  }
+}
+
+TEST_F(DesignStudyRuns, SweepKilledRepeatedlyResumesToTheUninterruptedResult) {
+  // 900 designs of a segmented (slower) tube cantilever: about half a second on two threads; the
+  // kill delays scale with the time the uninterrupted run takes.
+  const fs::path study = write_study("big.json", tube_grid(30, 30, 8));
+  ASSERT_NO_FATAL_FAILURE(run_ok(study, "ref", {"-j", "2"}));
+  const std::string reference = read_text(dir_ / "ref" / "samples.csv");
+  ASSERT_EQ(lines_of(reference).size(), 901u);
+  const double reference_ms =
+      1000 * load_json(dir_ / "ref" / "summary.json")["wall_seconds"].get<double>();
+  std::printf("uninterrupted run: %.0f ms\n", reference_ms);
+
+  const unsigned seed = std::random_device{}();
+  std::mt19937 rng(seed);
+  std::printf("kill delays from seed %u\n", seed);
+  const fs::path samples = dir_ / "out" / "samples.csv";
+  fs::create_directories(dir_ / "out");
+  int killed = 0;
+  for (int round = 0; round < 3; ++round) {
+    // 5% to 30% of the uninterrupted run's time.
+    const int delay_ms = static_cast<int>(reference_ms * (0.05 + 0.25 * (rng() % 1000) / 1000.0));
+    std::vector<std::string> args{"run", study.string(), "-o", "out", "--quiet", "-j", "2"};
+    if (round > 0) args.push_back("--resume");
+    beamrail::testing::Process p(BEAMRAIL_EXECUTABLE, args, dir_, std::to_string(round));
+    ASSERT_TRUE(p.started());
+    // The delay counts from the moment the table exists.
+    std::error_code ec;
+    while (p.alive() && !(fs::exists(samples, ec) && fs::file_size(samples, ec) > 0))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    p.kill(SIGKILL);
+    const ProcessResult r = p.wait(std::chrono::seconds(60));
+    size_t rows = 0;
+    ASSERT_TRUE(WholeRows(read_text(samples), &rows)) << "after round " << round;
+    std::printf("round %d: SIGKILL after %d ms: %s, %zu whole rows\n", round, delay_ms,
+                r.how.c_str(), rows);
+    if (!r.exited) {
+      EXPECT_EQ(r.signal, SIGKILL);
+      ++killed;
+    } else {
+      EXPECT_EQ(r.status, 0) << r.err;  // finished before the kill
+    }
+  }
+  EXPECT_GE(killed, 1) << "no run was interrupted: the test tested nothing";
+
+  ASSERT_NO_FATAL_FAILURE(run_ok(study, "out", {"--resume", "-j", "2"}));
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  std::printf("final resume: evaluated_now %d, resumed_from_table %d\n",
+              summary["evaluated_now"].get<int>(), summary["resumed_from_table"].get<int>());
+  EXPECT_EQ(summary["evaluated_now"].get<int>() + summary["resumed_from_table"].get<int>(), 900);
+  EXPECT_TRUE(
+      SameText(without_column(reference, "wall_s"), without_column(read_text(samples), "wall_s")));
+  EXPECT_TRUE(IndicesInOrder(samples, 900));
+}
+
+// --- 5. Designs that break the scene or the analysis --------------------------------------------
+
+// A slender steel wire cantilever in 8 segments with a tip body; the static analysis may take only
+// one Newton iteration, which a large load cannot satisfy.
+constexpr const char* kWireStudy = R"({
+  "name": "wire",
+  "scene": {
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"wire": {"shape": "circle", "diameter": 0.002}},
+    "bodies": [{"name": "tip", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5], "position": [1, 0, 0]}],
+    "beams": [{"name": "wire", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "wire",
+               "segments": 8}],
+    "loads": [{"type": "force", "body": "tip", "value": [0, 0, 0]}]
+  },
+  "analyses": [{"type": "static", "max_iterations": 1}],
+  "responses": {"dy": {"quantity": "displacement", "body": "tip", "direction": [0, -1, 0]},
+                "mass": {"quantity": "mass"}},
+  "study": {"type": "sweep", "sampling": "list",
+            "variables": [{"name": "x2", "pointer": "/scene/beams/0/point2/0"},
+                          {"name": "y3", "pointer": "/scene/beams/0/point3/1"},
+                          {"name": "load", "pointer": "/scene/loads/0/value/1"}],
+            "rows": []}
+})";
+
+TEST_F(DesignStudyRuns, DesignsThatBreakTheSceneOrTheAnalysisBecomeRowsAndTheBatchGoesOn) {
+  Json study = Json::parse(kWireStudy);
+  study["study"]["rows"] = Json::parse(R"([
+    [1.0, 1.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.9, 1.0, 0.0],
+    [1.0, 1.0, -100.0],
+    [1.0, 1.0, 0.0]
+  ])");
+  const std::vector<std::string> expected = {"ok", "invalid", "invalid", "ok", "failed", "ok"};
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wire.json", study), "out", {"-j", "2"}));
+  const Table t = read_table(dir_ / "out" / "samples.csv");
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  ASSERT_EQ(t.rows.size(), expected.size());
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    std::printf("row %zu: %s, dy %s, mass %s, message \"%s\"\n", i, t.at(i, "status").c_str(),
+                t.at(i, "dy").c_str(), t.at(i, "mass").c_str(), t.at(i, "message").c_str());
+    EXPECT_EQ(t.at(i, "status"), expected[i]) << "row " << i;
+    if (expected[i] == "ok") {
+      EXPECT_EQ(t.at(i, "message"), "") << "row " << i;
+      EXPECT_TRUE(std::isfinite(std::strtod(t.at(i, "dy").c_str(), nullptr))) << "row " << i;
+    } else {
+      EXPECT_EQ(t.at(i, "dy"), "nan") << "row " << i;
+    }
+  }
+  const std::string& coincide = t.at(1, "message");
+  EXPECT_NE(coincide.find("/scene/beams/0/point2"), std::string::npos) << coincide;
+  EXPECT_NE(coincide.find("coincide"), std::string::npos) << coincide;
+  const std::string& axis = t.at(2, "message");
+  EXPECT_NE(axis.find("/scene/beams/0/point3"), std::string::npos) << axis;
+  EXPECT_NE(axis.find("axis"), std::string::npos) << axis;
+  const std::string& failed = t.at(4, "message");
+  EXPECT_NE(failed.find("static"), std::string::npos) << failed;
+  EXPECT_NE(failed.find("converge"), std::string::npos) << failed;
+  EXPECT_EQ(summary["failed_or_invalid"], 3);
+  EXPECT_EQ(summary["status"], "ok");
+}
+
+// --- 6. Design variables that address no number -------------------------------------------------
+
+TEST_F(DesignStudyRuns, VariableAtAMissingPathOrAtAStringIsBadInput) {
+  const struct {
+    const char* pointer;
+    const char* phrase;
+  } cases[] = {
+      {"/scene/sections/rod/diametre", "\"/scene/sections/rod/diametre\" does not exist"},
+      {"/scene/beams/0/material", "\"/scene/beams/0/material\" is a string, not a number"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.pointer);
+    Json study = load_json(kStudies / "min_mass_rod.json");
+    study["study"]["variables"][0]["pointer"] = c.pointer;
+    write_study("bad.json", study);
+    for (const char* command : {"check", "run"}) {
+      const ProcessResult r = command == std::string("run")
+                                  ? run({"run", "bad.json", "-o", "out", "--quiet"})
+                                  : run({"check", "bad.json"});
+      std::printf("%s %s: %s; stderr: %s", command, c.pointer, r.how.c_str(), r.err.c_str());
+      EXPECT_TRUE(r.exited && r.status == 2) << r.how;
+      const std::vector<std::string> lines = lines_of(r.err);
+      ASSERT_EQ(lines.size(), 1u) << r.err;
+      EXPECT_EQ(lines[0].rfind("bad.json:/study/variables/0/pointer: ", 0), 0u) << lines[0];
+      EXPECT_NE(lines[0].find(c.phrase), std::string::npos) << lines[0];
+      EXPECT_FALSE(fs::exists(dir_ / "out" / "summary.json"));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace beamrail

@@ -62,6 +62,7 @@ class TangentSolver {
   bool factorize(const Eigen::SparseMatrix<double>& s, std::string* failure) {
     matrix_ = s;
     use_dense_ = false;
+    null_directions = 0;
     lu_.compute(matrix_);
     if (lu_.info() == Eigen::Success) {
       // Check one solve: a numerically singular matrix factorizes but solves badly.
@@ -80,6 +81,7 @@ class TangentSolver {
     use_dense_ = true;
     return true;
   }
+  Eigen::VectorXd apply(const Eigen::VectorXd& x) const { return matrix_ * x; }
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const {
     return use_dense_ ? Eigen::VectorXd(cod_.solve(b)) : Eigen::VectorXd(lu_.solve(b));
   }
@@ -102,6 +104,7 @@ struct Newton {
   double residual = 0.0;
   std::string failure;
   TangentSolver solver;
+  bool no_equilibrium = false;
 
   double residual_at(double factor) {
     compute_wrenches(model, data, t, factor);
@@ -127,11 +130,15 @@ struct Newton {
   // test with the old tangent (which does not see the tension) stalled. So the line search only
   // backtracks (halving) from steps that make the forces non-finite; divergence is caught by the
   // iteration limit and answered by a smaller load step.
-  bool solve(double factor, double target) {
-    double r = residual_at(factor);
-    int rising = 0;
+  // target: the residual asked for; floor: what rounding alone leaves (rounding_floor). A
+  // residual below 10 floor that Newton no longer reduces is converged; a correction below the
+  // resolution of the coordinates with a residual above that means the loads push along a
+  // direction without stiffness, and is a failure, never an equilibrium.
+  bool solve(double factor, double target, double floor) {
+    double r = residual_at(factor), best = r;
+    int rising = 0, stalled = 0;
     for (int it = 0; it < max_iterations; ++it) {
-      if (r <= target) {
+      if (r <= target || (r <= 10.0 * floor && stalled >= 2)) {
         residual = r;
         return true;
       }
@@ -145,10 +152,22 @@ struct Newton {
         failure = "the tangent stiffness is singular";
         return false;
       }
-      // Converged to rounding: the correction is below the resolution of the coordinates.
+      if (solver.null_directions > 0 && scaled_norm(solver.apply(dx) + w, length) >
+                                            std::max(1e-6 * scaled_norm(w, length), 10.0 * floor)) {
+        failure =
+            "the loads push along a direction without stiffness (a free mechanism, such as a "
+            "carriage pushed along its rails): there is no equilibrium";
+        no_equilibrium = true;
+        return false;
+      }
       if (size(dx) <= 1e-14 * length) {
         residual = r;
-        return true;
+        if (r <= 10.0 * floor) return true;  // converged to rounding
+        failure =
+            "the loads cannot be balanced (the Newton correction vanishes while the residual "
+            "stays at " +
+            std::to_string(r) + " N)";
+        return false;
       }
       const std::vector<Pose<double>> pose = data.pose;
       const std::vector<Vec4> q = data.q;
@@ -168,6 +187,8 @@ struct Newton {
         return false;
       }
       rising = value > r ? rising + 1 : 0;
+      stalled = value < 0.5 * best ? 0 : stalled + 1;
+      best = std::min(best, value);
       r = value;
       if (rising >= 8) {
         failure = "Newton diverges (the residual grew 8 times in a row)";
@@ -176,7 +197,8 @@ struct Newton {
     }
     residual = r;
     if (r <= target) return true;
-    failure = "Newton did not converge in " + std::to_string(max_iterations) + " iterations";
+    failure = "Newton did not converge in " + std::to_string(max_iterations) +
+              (max_iterations == 1 ? " iteration" : " iterations");
     return false;
   }
 };
@@ -191,7 +213,8 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
     const double length = characteristic_length(model);
     const double f_ref = reference_force(model, options.time, length);
     result.reference_force = f_ref;
-    Newton newton{model, data, options.time, length, options.max_iterations, 0, 0, 0.0, {}, {}};
+    Newton newton{model, data, options.time, length, options.max_iterations, 0, 0,
+                  0.0,   {},   {},           false};
     const double floor = rounding_floor(model, data);
 
     double done = 0.0;  // load factor reached
@@ -207,18 +230,21 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
       const std::vector<Vec4> q = data.q;
       ++result.load_steps;
       newton.failure.clear();
-      if (newton.solve(factor, std::max(factor * options.tolerance * f_ref, floor))) {
+      if (newton.solve(factor, factor * options.tolerance * f_ref, floor)) {
         done = factor;
         if (options.load_steps == 0) increment = std::min(1.0, 2.0 * increment);
         continue;
       }
-      // Back to the last equilibrium with a smaller load increment.
+      // Back to the last equilibrium with a smaller load increment (unless no increment can
+      // help: the loads have no equilibrium at all).
       data.pose = pose;
       data.q = q;
       increment *= 0.5;
-      if (increment < min_increment) {
-        result.message = newton.failure + " (load step cut below 2^-20 at load factor " +
-                         std::to_string(done) + ")";
+      if (newton.no_equilibrium || increment < min_increment) {
+        char where[120];
+        std::snprintf(where, sizeof where, " (at load factor %.6g, %d load steps)", factor,
+                      result.load_steps);
+        result.message = newton.failure + where;
         break;
       }
     }
@@ -227,6 +253,14 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
     compute_wrenches(model, data, options.time, result.ok ? 1.0 : done);
     result.residual_norm = scaled_norm(wrench_vector(model, data), length);
     result.iterations = newton.iterations;
+    if (result.ok && !(result.residual_norm <= std::max(options.tolerance * f_ref, 10.0 * floor))) {
+      // Never an equilibrium that does not balance the loads.
+      result.ok = false;
+      char text[160];
+      std::snprintf(text, sizeof text, "the residual %.3g N does not balance the loads",
+                    result.residual_norm);
+      result.message = text;
+    }
     if (result.ok && result.residual_norm > std::max(options.tolerance, 1e-6) * f_ref) {
       char text[200];
       std::snprintf(text, sizeof text,

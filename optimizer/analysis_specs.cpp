@@ -13,18 +13,36 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
                      IntegratorOptions& io) {
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return;
-  if (const auto m = r.choice("method", false, {"bdf"})) io.method = *m;
+  if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk"})) io.method = *m;
+  if (const auto t = r.string("table", false)) {
+    if (io.method != "dirk" && io.method != "erk")
+      r.error("table", "a Butcher table applies to the \"dirk\" and \"erk\" methods");
+    else
+      io.table = *t;
+  }
   io.rtol = r.positive("rtol", false).value_or(io.rtol);
   io.atol = r.positive("atol", false).value_or(io.atol);
   if (const auto j = r.choice("jacobian", false, {"exact", "fd"}))
     io.jacobian = *j == "exact" ? JacobianKind::kExact : JacobianKind::kFiniteDifference;
-  if (const auto s = r.choice("linear_solver", false, {"auto", "dense"}))
-    io.linear_solver = *s == "dense" ? LinearSolverKind::kDense : LinearSolverKind::kAuto;
+  if (const auto s = r.choice("linear_solver", false, {"auto", "dense", "sparse"}))
+    io.linear_solver = *s == "dense"    ? LinearSolverKind::kDense
+                       : *s == "sparse" ? LinearSolverKind::kSparse
+                                        : LinearSolverKind::kAuto;
+  if (io.jacobian == JacobianKind::kFiniteDifference && io.linear_solver == LinearSolverKind::kSparse)
+    r.error("jacobian", "finite-difference Jacobians need the dense linear solver");
   if (const auto q = r.integer("max_order", false, 1)) {
-    if (*q > 5)
-      r.error("max_order", "BDF orders go from 1 to 5");
+    const int limit = io.method == "adams" ? 12 : 5;
+    if (io.method != "bdf" && io.method != "adams")
+      r.error("max_order", "applies to the \"bdf\" and \"adams\" methods");
+    else if (*q > limit)
+      r.error("max_order", io.method + " orders go from 1 to " + std::to_string(limit));
     else
       io.max_order = static_cast<int>(*q);
+  }
+  if (const auto d = r.boolean("stability_limit_detection", false)) {
+    if (io.method != "bdf")
+      r.error("stability_limit_detection", "applies to the \"bdf\" method");
+    io.stability_limit_detection = *d;
   }
   io.max_step = r.positive("max_step", false).value_or(0.0);
   io.initial_step = r.positive("initial_step", false).value_or(0.0);

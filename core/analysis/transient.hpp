@@ -16,13 +16,21 @@ namespace beamrail {
 enum class JacobianKind { kExact, kFiniteDifference };
 enum class LinearSolverKind { kAuto, kDense, kSparse };
 
+// Defaults of the integrator families (measured: see README "Speed and accuracy").
+inline constexpr const char* kDefaultDirkTable = "ARK548L2SA_DIRK_8_4_5";
+inline constexpr const char* kDefaultErkTable = "DORMAND_PRINCE_7_4_5";
+// linear_solver "auto": dense below this many states, sparse (KLU) from it.
+inline constexpr long kSparseStateThreshold = 130;
+
 struct IntegratorOptions {
-  std::string method = "bdf";
-  double rtol = 1e-6;  // relative tolerance
-  double atol = 1e-9;  // absolute tolerance (states in m, -, m/s, rad/s)
+  std::string method = "bdf";  // bdf | adams (CVODE), dirk | erk (ARKODE)
+  std::string table;           // dirk/erk: ARKODE Butcher table name ("" = default)
+  double rtol = 1e-6;          // relative tolerance
+  double atol = 1e-9;          // absolute tolerance (states in m, -, m/s, rad/s)
   JacobianKind jacobian = JacobianKind::kExact;
   LinearSolverKind linear_solver = LinearSolverKind::kAuto;
-  int max_order = 5;          // BDF order limit, 1..5
+  int max_order = 5;          // BDF order limit 1..5 (Adams: 1..12)
+  bool stability_limit_detection = false;  // CVODE's BDF stability limit detection
   double max_step = 0.0;      // [s]; 0: no limit
   double initial_step = 0.0;  // [s]; 0: the integrator's estimate
   long max_steps = 10000000;  // total step budget over the run
@@ -53,8 +61,10 @@ struct SolverStats {
 
 struct TransientResult {
   bool ok = false;
-  std::string message;     // why it stopped early, when !ok
-  double t_reached = 0.0;  // last time integrated to [s]
+  std::string linear_solver;   // dense | sparse | none
+  long jacobian_nonzeros = 0;  // stored entries of the sparse Jacobian
+  std::string message;         // why it stopped early, when !ok
+  double t_reached = 0.0;      // last time integrated to [s]
   SolverStats stats;
   std::vector<std::string> warnings;
 };

@@ -45,8 +45,8 @@ double end_stress(const SectionProperties& s, const EndForces& forces) {
     return std::numeric_limits<double>::quiet_NaN();
   double worst = 0.0;
   for (const Vec6* p : {&forces.end1, &forces.end2})
-    worst = std::max(worst, std::abs((*p)(0)) / s.area + std::abs((*p)(4)) / s.wy +
-                                std::abs((*p)(5)) / s.wz);
+    worst = std::max(
+        worst, std::abs((*p)(0)) / s.area + std::abs((*p)(4)) / s.wy + std::abs((*p)(5)) / s.wz);
   return worst;
 }
 

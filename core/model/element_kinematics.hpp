@@ -44,32 +44,39 @@ struct ElementFrames {
   Mat3T<T> t;       // d phi / d (small rotation of the right end in the left-end frame)
 };
 
+// The rotation angles phi of a relative rotation a and T = d phi / d (small rotation of the right
+// end in the left-end frame); twist_free: both bending angles from the first column.
+template <class T>
+void relative_angles(const Mat3T<T>& a, bool twist_free, Vec3T<T>& phi, Mat3T<T>& t) {
+  using std::atan2;
+  phi << atan2(a(2, 1), a(1, 1)), atan2(a(0, 2), a(2, 2)), atan2(a(1, 0), a(0, 0));
+  const T nx = a(1, 1) * a(1, 1) + a(2, 1) * a(2, 1);
+  const T nz = a(0, 0) * a(0, 0) + a(1, 0) * a(1, 0);
+  t(0, 0) = T(1), t(0, 1) = -a(0, 1) * a(1, 1) / nx, t(0, 2) = -a(0, 1) * a(2, 1) / nx;
+  t(2, 0) = -a(0, 0) * a(2, 0) / nz, t(2, 1) = -a(1, 0) * a(2, 0) / nz, t(2, 2) = T(1);
+  if (twist_free) {
+    const T n = a(0, 0) * a(0, 0) + a(2, 0) * a(2, 0);
+    phi(1) = atan2(-a(2, 0), a(0, 0));
+    t(1, 0) = -a(0, 0) * a(1, 0) / n, t(1, 1) = T(1), t(1, 2) = -a(1, 0) * a(2, 0) / n;
+  } else {
+    const T ny = a(0, 2) * a(0, 2) + a(2, 2) * a(2, 2);
+    t(1, 0) = -a(0, 2) * a(1, 2) / ny, t(1, 1) = T(1), t(1, 2) = -a(1, 2) * a(2, 2) / ny;
+  }
+}
+
 template <class T>
 ElementFrames<T> element_frames(const ElementEnds& ends, const Pose<T>& b1, const Pose<T>& b2,
                                 bool twist_free_bending = false) {
-  using std::atan2;
   ElementFrames<T> f;
-  f.E1 = b1.A * ends.frame1.cast<T>();
-  const Mat3T<T> e2 = b2.A * ends.frame2.cast<T>();
-  f.R1 = b1.A * ends.r1.cast<T>();
-  f.R2 = b2.A * ends.r2.cast<T>();
+  f.E1 = b1.A * ends.frame1;
+  const Mat3T<T> e2 = b2.A * ends.frame2;
+  f.R1 = b1.A * ends.r1;
+  f.R2 = b2.A * ends.r2;
   const Vec3T<T> p2 = b2.c + f.R2;
   f.lever1 = p2 - b1.c;
   f.xi = f.E1.transpose() * (f.lever1 - f.R1);
   f.a = f.E1.transpose() * e2;
-  const Mat3T<T>& a = f.a;
-  f.phi << atan2(a(2, 1), a(1, 1)), atan2(a(0, 2), a(2, 2)), atan2(a(1, 0), a(0, 0));
-  const T nx = a(1, 1) * a(1, 1) + a(2, 1) * a(2, 1);
-  const T ny = a(0, 2) * a(0, 2) + a(2, 2) * a(2, 2);
-  const T nz = a(0, 0) * a(0, 0) + a(1, 0) * a(1, 0);
-  f.t << T(1), -a(0, 1) * a(1, 1) / nx, -a(0, 1) * a(2, 1) / nx,  //
-      -a(0, 2) * a(1, 2) / ny, T(1), -a(1, 2) * a(2, 2) / ny,     //
-      -a(0, 0) * a(2, 0) / nz, -a(1, 0) * a(2, 0) / nz, T(1);
-  if (twist_free_bending) {
-    const T n = a(0, 0) * a(0, 0) + a(2, 0) * a(2, 0);
-    f.phi(1) = atan2(-a(2, 0), a(0, 0));
-    f.t.row(1) << -a(0, 0) * a(1, 0) / n, T(1), -a(1, 0) * a(2, 0) / n;
-  }
+  relative_angles(f.a, twist_free_bending, f.phi, f.t);
   return f;
 }
 

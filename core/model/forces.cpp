@@ -70,32 +70,54 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
     data.stiffness[k].block<3, 3>(3, 3) += skew<double>(value) * skew<double>(lever);
   }
 
+  // The closed-form Jacobian for undamped elements, and for every element when velocities do not
+  // matter (static and modal analyses linearize at rest, where damping forces vanish); forward
+  // AD through the whole kernel (positions and velocities) for damped elements in motion.
   for (size_t n = 0; n < model.beams.size(); ++n) {
     const Beam& e = model.beams[n];
-    const auto kernel = [&e](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
-                             Vec6T<Ad12>& w2) { beam_wrenches(e, b1, b2, w1, w2); };
     const Pose<double>& p1 = data.pose[e.ends.body1];
     const Pose<double>& p2 = data.pose[e.ends.body2];
     const auto& blocks = model.pattern.beam_blocks[n];
+    if (e.damping == 0.0 || !with_velocity) {
+      scatter(blocks,
+              configuration_jacobian(element_frames(e.ends, p1, p2), e.formulation, false,
+                                     [&e](const Vec6T<Ad6>& s) { return beam_law(e, s); }),
+              data.stiffness);
+      continue;
+    }
+    const auto kernel = [&e](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
+                             Vec6T<Ad12>& w2) { beam_wrenches(e, b1, b2, w1, w2); };
     scatter(blocks, element_jacobian(seed_configuration(p1, 0), seed_configuration(p2, 6), kernel),
             data.stiffness);
-    if (with_velocity && e.damping > 0.0)
+    if (with_velocity)
       scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
               data.damping);
   }
   for (size_t n = 0; n < model.rails.size(); ++n) {
     const Rail& e = model.rails[n];
+    const Pose<double>& p1 = data.pose[e.ends.body1];
+    const Pose<double>& p2 = data.pose[e.ends.body2];
+    const auto& blocks = model.pattern.rail_blocks[n];
+    const bool twist_free = e.type == RailType::kCylindrical;
+    if (e.damping == 0.0 || !with_velocity) {
+      scatter(blocks,
+              configuration_jacobian(element_frames(e.ends, p1, p2, twist_free), e.formulation,
+                                     twist_free,
+                                     [&e](const Vec6T<Ad6>& s) {
+                                       bool floored = false;
+                                       return rail_law(e, s, &floored);
+                                     }),
+              data.stiffness);
+      continue;
+    }
     const auto kernel = [&e](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
                              Vec6T<Ad12>& w2) {
       bool floored = false;
       rail_wrenches(e, b1, b2, w1, w2, &floored);
     };
-    const Pose<double>& p1 = data.pose[e.ends.body1];
-    const Pose<double>& p2 = data.pose[e.ends.body2];
-    const auto& blocks = model.pattern.rail_blocks[n];
     scatter(blocks, element_jacobian(seed_configuration(p1, 0), seed_configuration(p2, 6), kernel),
             data.stiffness);
-    if (with_velocity && e.damping > 0.0)
+    if (with_velocity)
       scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
               data.damping);
   }

@@ -14,6 +14,8 @@ void compute_wrenches(const Model& model, Data& data, double t, double load_fact
 
 // Sets data.stiffness (and data.damping when with_velocity) for every block of model.pattern at
 // time t from data.pose; the velocity blocks are exact for any scene, zero without damping.
+// Without with_velocity the bodies are taken at rest (static and modal analyses): damping forces
+// and their derivatives vanish there.
 void compute_tangent(const Model& model, Data& data, double t, bool with_velocity,
                      double load_factor = 1.0);
 

@@ -7,7 +7,8 @@ namespace beamrail {
 namespace {
 
 // Registers the four couplings of an element between bodies a and b.
-std::array<int, 4> couple(const std::vector<Body>& bodies, std::map<std::pair<int, int>, int>& index,
+std::array<int, 4> couple(const std::vector<Body>& bodies,
+                          std::map<std::pair<int, int>, int>& index,
                           std::vector<BlockPattern::Block>& blocks, int a, int b) {
   const int fa = bodies[a].free_index, fb = bodies[b].free_index;
   auto block = [&](int r, int c) {

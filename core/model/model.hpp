@@ -15,17 +15,17 @@ namespace beamrail {
 
 struct Body {
   std::string name;
-  double mass = 0.0;                       // kg (0 for fixed bodies that were given none)
-  Mat3 inertia = Mat3::Zero();             // about the centre of mass, body axes [kg m^2]
-  Mat3 inertia_inverse = Mat3::Zero();     // its inverse (free bodies only)
-  Vec3 position = Vec3::Zero();            // initial centre of mass, global [m]
-  Vec4 orientation = Vec4(1, 0, 0, 0);     // initial Euler parameters (body -> global)
-  Vec3 velocity = Vec3::Zero();            // initial velocity of the centre of mass, global [m/s]
-  Vec3 angular_velocity = Vec3::Zero();    // initial angular velocity, body axes [rad/s]
+  double mass = 0.0;                     // kg (0 for fixed bodies that were given none)
+  Mat3 inertia = Mat3::Zero();           // about the centre of mass, body axes [kg m^2]
+  Mat3 inertia_inverse = Mat3::Zero();   // its inverse (free bodies only)
+  Vec3 position = Vec3::Zero();          // initial centre of mass, global [m]
+  Vec4 orientation = Vec4(1, 0, 0, 0);   // initial Euler parameters (body -> global)
+  Vec3 velocity = Vec3::Zero();          // initial velocity of the centre of mass, global [m/s]
+  Vec3 angular_velocity = Vec3::Zero();  // initial angular velocity, body axes [rad/s]
   bool fixed = false;
-  bool generated = false;                  // interior body of a segmented beam
-  double declared_mass = 0.0;              // the mass given in the scene, before segment masses
-  int free_index = -1;                     // position among the free bodies, -1 if fixed
+  bool generated = false;      // interior body of a segmented beam
+  double declared_mass = 0.0;  // the mass given in the scene, before segment masses
+  int free_index = -1;         // position among the free bodies, -1 if fixed
 };
 
 // Where an element attaches to its two bodies; computed once at set-up (DESIGN.md §1).
@@ -58,9 +58,9 @@ struct Beam {
   double damping = 0.0;         // stiffness-proportional beta [s]
   Formulation formulation = Formulation::kEnergy;
   SectionProperties section;
-  double density = 0.0;         // kg/m^3, 0 when not given
-  std::string group;            // the scene beam this element models (its own name if unsplit)
-  int segment = 0;              // 1..n for the segments of a split beam, 0 otherwise
+  double density = 0.0;  // kg/m^3, 0 when not given
+  std::string group;     // the scene beam this element models (its own name if unsplit)
+  int segment = 0;       // 1..n for the segments of a split beam, 0 otherwise
 };
 
 enum class RailType { kPrismatic, kCylindrical };
@@ -94,7 +94,7 @@ struct BlockPattern {
   struct Block {
     int row = 0, col = 0;  // free-body indices
   };
-  std::vector<Block> blocks;        // diagonal blocks first (block k = free body k)
+  std::vector<Block> blocks;  // diagonal blocks first (block k = free body k)
   // Per element, the block index of (end a, end b) for a, b in {1, 2}, or -1 when either end is
   // a fixed body: [0] = (1,1), [1] = (1,2), [2] = (2,1), [3] = (2,2).
   std::vector<std::array<int, 4>> beam_blocks;

@@ -11,17 +11,63 @@
 
 namespace beamrail {
 
-// Current deformable length: l = xi_x with |l| >= min_length. Sets *floored when the floor acts.
+// Current deformable length from the axial coordinate x = xi_x: l = x with |l| >= min_length.
+// Sets *floored when the floor acts.
 template <class T>
-T rail_length(const Rail& rail, const ElementFrames<T>& f, bool* floored) {
+T rail_length(const Rail& rail, const T& x, bool* floored) {
   using std::abs;
-  const T l = f.xi(0);
-  if (abs(l) >= rail.min_length) {
+  if (abs(x) >= rail.min_length) {
     *floored = false;
-    return l;
+    return x;
   }
   *floored = true;
-  return T(l < T(0) ? -rail.min_length : rail.min_length);
+  return T(x < 0.0 ? -rail.min_length : rail.min_length);
+}
+
+// The rail's force law on s = (xi, phi): delta = (0, xi_y, xi_z, phi) with the stiffness of a
+// cantilever of length l = xi_x. Energy: g = dU/ds, whose first entry is the configurational force
+// dU/dl along the rail (zero while l is floored); paper: p1 = K1(l) delta, p2 = K2(l) delta.
+template <class S>
+LocalForces<S> rail_law(const Rail& rail, const Vec6T<S>& s, bool* floored) {
+  const S l = rail_length(rail, S(s(0)), floored);
+  const StiffnessBlocks<S> k(0.0, rail.gj, rail.eiy, rail.eiz, l);
+  Vec6T<S> d = s;
+  d(0) = S(0.0);
+  LocalForces<S> out;
+  if (rail.formulation == Formulation::kEnergy) {
+    out.g = k.k2(d);
+    out.g(0) = *floored ? S(0.0)
+                        : (l < 0.0 ? S(-1.0) : S(1.0)) *
+                              strain_energy_length_derivative(rail.gj, rail.eiy, rail.eiz, l, d);
+  } else {
+    out.p1 = k.k1(d);
+    out.p2 = k.k2(d);
+  }
+  out.energy = strain_energy(k, d);
+  return out;
+}
+
+// Adds the rail's wrenches on body 1 (the rail) and body 2 (the carriage) to w1 and w2 and returns
+// the strain energy 1/2 delta^T K2(l) delta [J]. Sets *floored when |l| hit min_length.
+template <class T>
+T rail_wrenches(const Rail& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
+                bool* floored) {
+  const ElementFrames<T> f = element_frames(rail.ends, b1, b2, rail.type == RailType::kCylindrical);
+  Vec6T<T> s;
+  s << f.xi, f.phi;
+  const LocalForces<T> law = rail_law(rail, s, floored);
+  Vec6T<T> g = Vec6T<T>::Zero();
+  if (rail.formulation == Formulation::kEnergy)
+    g = law.g;
+  else
+    apply_paper_end_wrenches(f, law.p1, law.p2, w1, w2);
+  if (rail.damping > 0.0) {
+    const StiffnessBlocks<T> k(0.0, rail.gj, rail.eiy, rail.eiz,
+                               rail_length(rail, f.xi(0), floored));
+    g += rail.damping * k.k2(deformation_rate(f, b1, b2));
+  }
+  apply_deformation_gradient(f, g, w1, w2);
+  return law.energy;
 }
 
 // Deformation of a rail: no axial part (the carriage slides).
@@ -30,32 +76,6 @@ Vec6T<T> rail_deformation(const ElementFrames<T>& f) {
   Vec6T<T> d;
   d << T(0), f.xi(1), f.xi(2), f.phi(0), f.phi(1), f.phi(2);
   return d;
-}
-
-// Adds the rail's wrenches on body 1 (the rail) and body 2 (the carriage) to w1 and w2 and returns
-// the strain energy 1/2 delta^T K2(l) delta [J]. Sets *floored when |l| hit min_length.
-template <class T>
-T rail_wrenches(const Rail& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
-                bool* floored) {
-  const ElementFrames<T> f =
-      element_frames(rail.ends, b1, b2, rail.type == RailType::kCylindrical);
-  const T l = rail_length(rail, f, floored);
-  const StiffnessBlocks<T> k(0.0, rail.gj, rail.eiy, rail.eiz, l);
-  const Vec6T<T> d = rail_deformation(f);
-  Vec6T<T> g = Vec6T<T>::Zero();
-  if (rail.formulation == Formulation::kEnergy) {
-    g = k.k2(d);
-    // U depends on xi_x through l: the configurational force along the rail.
-    if (!*floored) {
-      const T s = l < T(0) ? T(-1) : T(1);
-      g(0) = s * strain_energy_length_derivative(rail.gj, rail.eiy, rail.eiz, l, d);
-    }
-  } else {
-    apply_paper_end_wrenches(f, k.k1(d), k.k2(d), w1, w2);
-  }
-  if (rail.damping > 0.0) g += rail.damping * k.k2(deformation_rate(f, b1, b2));
-  apply_deformation_gradient(f, g, w1, w2);
-  return strain_energy(k, d);
 }
 
 }  // namespace beamrail

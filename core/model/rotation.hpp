@@ -1,5 +1,5 @@
-// Rotations: Euler parameters (unit quaternions, scalar first), rotation matrices, skew matrices and
-// the small-rotation increments ("rotation vectors") used as generalized coordinates.
+// Rotations: Euler parameters (unit quaternions, scalar first), rotation matrices, skew matrices
+// and the small-rotation increments ("rotation vectors") used as generalized coordinates.
 //
 // Conventions: A(q) maps body axes to global axes. A rotation increment theta (global axes) changes
 // A to exp([theta]x) A, which in Euler parameters is q -> quat(theta) (x) q.
@@ -19,16 +19,18 @@ Mat3T<T> skew(const Vec3T<T>& v) {
   return s;
 }
 
-// Body-to-global rotation matrix of the Euler parameters q; q need not be normalized (q/|q| is used).
+// Body-to-global rotation matrix of the Euler parameters q; q need not be normalized (q/|q| is
+// used).
 template <class T>
 Mat3T<T> rotation_matrix(const Vec4T<T>& q_raw) {
   using std::sqrt;
   const Vec4T<T> q = q_raw / sqrt(q_raw.squaredNorm());
   const T q0 = q(0), q1 = q(1), q2 = q(2), q3 = q(3);
   Mat3T<T> a;
-  a << q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, T(2) * (q1 * q2 - q0 * q3), T(2) * (q1 * q3 + q0 * q2),
-      T(2) * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3, T(2) * (q2 * q3 - q0 * q1),
-      T(2) * (q1 * q3 - q0 * q2), T(2) * (q2 * q3 + q0 * q1), q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3;
+  a << q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3, T(2) * (q1 * q2 - q0 * q3),
+      T(2) * (q1 * q3 + q0 * q2), T(2) * (q1 * q2 + q0 * q3), q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3,
+      T(2) * (q2 * q3 - q0 * q1), T(2) * (q1 * q3 - q0 * q2), T(2) * (q2 * q3 + q0 * q1),
+      q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3;
   return a;
 }
 

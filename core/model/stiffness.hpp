@@ -14,15 +14,15 @@ namespace beamrail {
 
 template <class T>
 struct StiffnessBlocks {
-  T a, t;               // axial E S / L, torsional G Ix / L
-  T y3, y2, y1, y0;     // 12 EIy / L^3, 6 s EIy / L^2, 4 EIy / L, 2 EIy / L
-  T z3, z2, z1, z0;     // the same with EIz
+  T a, t;            // axial E S / L, torsional G Ix / L
+  T y3, y2, y1, y0;  // 12 EIy / L^3, 6 s EIy / L^2, 4 EIy / L, 2 EIy / L
+  T z3, z2, z1, z0;  // the same with EIz
 
   // ea, gj, eiy, eiz: rigidities; length: signed length l with |l| > 0.
   StiffnessBlocks(double ea, double gj, double eiy, double eiz, const T& length) {
     using std::abs;
     const T len = abs(length);
-    const T s = length < T(0) ? T(-1) : T(1);
+    const T s = length < 0.0 ? T(-1) : T(1);
     a = ea / len;
     t = gj / len;
     y1 = 4.0 * eiy / len;
@@ -35,26 +35,38 @@ struct StiffnessBlocks {
     z3 = 12.0 * eiz / (len * len * len);
   }
 
-  // K2 d: the end vector at point 2 (forces, moments; left-end frame).
-  Vec6T<T> k2(const Vec6T<T>& d) const {
-    Vec6T<T> p;
+  // K2 d: the end vector at point 2 (forces, moments; left-end frame). The deformation's scalar
+  // may differ from the coefficients' (constant coefficients times derivative-carrying values).
+  template <class D>
+  Vec6T<D> k2(const Vec6T<D>& d) const {
+    Vec6T<D> p;
     p << a * d(0), z3 * d(1) - z2 * d(5), y3 * d(2) + y2 * d(4), t * d(3), y2 * d(2) + y1 * d(4),
         -z2 * d(1) + z1 * d(5);
     return p;
   }
 
   // K1 d: the end vector at point 1.
-  Vec6T<T> k1(const Vec6T<T>& d) const {
-    Vec6T<T> p;
+  template <class D>
+  Vec6T<D> k1(const Vec6T<D>& d) const {
+    Vec6T<D> p;
     p << -a * d(0), -z3 * d(1) + z2 * d(5), -y3 * d(2) - y2 * d(4), -t * d(3),
         y2 * d(2) + y0 * d(4), -z2 * d(1) + z0 * d(5);
     return p;
   }
 };
 
+// A local force law evaluated on the deformation coordinates s = (xi, phi) of an element: the
+// energy gradient g = dU/ds (energy formulation) or the end vectors p1 = K1 delta, p2 = K2 delta
+// (paper formulation), and the strain energy.
+template <class S>
+struct LocalForces {
+  Vec6T<S> g, p1, p2;
+  S energy;
+};
+
 // The strain energy 1/2 d^T K2 d.
-template <class T>
-T strain_energy(const StiffnessBlocks<T>& k, const Vec6T<T>& d) {
+template <class S, class T>
+T strain_energy(const StiffnessBlocks<S>& k, const Vec6T<T>& d) {
   return T(0.5) * d.dot(k.k2(d));
 }
 
@@ -66,7 +78,8 @@ T strain_energy_length_derivative(double gj, double eiy, double eiz, const T& le
   const T len = abs(length);
   const T s = length < T(0) ? T(-1) : T(1);
   const T l2 = len * len, l3 = l2 * len, l4 = l3 * len;
-  // dU/dL = 1/2 [-36 EI u^2 / L^4 +- 24 s EI u phi / L^3 - 4 EI phi^2 / L^2] per plane, plus torsion.
+  // dU/dL = 1/2 [-36 EI u^2 / L^4 +- 24 s EI u phi / L^3 - 4 EI phi^2 / L^2] per plane, plus
+  // torsion.
   const T bend_z = -36.0 * eiz * d(1) * d(1) / l4 + 24.0 * s * eiz * d(1) * d(5) / l3 -
                    4.0 * eiz * d(5) * d(5) / l2;
   const T bend_y = -36.0 * eiy * d(2) * d(2) / l4 - 24.0 * s * eiy * d(2) * d(4) / l3 -

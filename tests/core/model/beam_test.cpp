@@ -81,7 +81,8 @@ TEST(Beam, ForcesBalanceAndMomentsBalanceLocally) {
       // Energy: exact balance on the deformed lever xi; paper: K1, K2 balance on (l, 0, 0).
       const Vec3 lever = f == Formulation::kEnergy ? fr.xi : Vec3(s.beam.ends.length, 0, 0);
       const double moment_scale = m1.norm() + m2.norm() + lever.norm() * scale;
-      worst_moment = std::max(worst_moment, (m1 + m2 + lever.cross(f2_local)).norm() / moment_scale);
+      worst_moment =
+          std::max(worst_moment, (m1 + m2 + lever.cross(f2_local)).norm() / moment_scale);
     }
     std::printf("%s: worst |F1+F2|/|F| = %.2e, worst local moment balance = %.2e\n", name(f),
                 worst_force, worst_moment);
@@ -96,8 +97,8 @@ TEST(Beam, EnergyFormulationConservesAngularMomentumExactly) {
     BeamCase s = random_case(rng, Formulation::kEnergy);
     deform(rng, s, 3e-2);
     const Wrenches w = evaluate(s.beam, s.b1, s.b2);
-    const Vec3 total = s.b1.c.cross(w.w1.head<3>()) + w.w1.tail<3>() + s.b2.c.cross(w.w2.head<3>()) +
-                       w.w2.tail<3>();
+    const Vec3 total = s.b1.c.cross(w.w1.head<3>()) + w.w1.tail<3>() +
+                       s.b2.c.cross(w.w2.head<3>()) + w.w2.tail<3>();
     const double scale = w.w1.tail<3>().norm() + w.w2.tail<3>().norm() +
                          (s.b1.c.norm() + s.b2.c.norm()) * w.w1.head<3>().norm();
     EXPECT_LT(total.norm() / scale, 1e-12);
@@ -158,8 +159,9 @@ TEST(Beam, ForcesEqualStiffnessTimesDeformationWhenSmall) {
       worst = std::max(worst, (p1 + k1).norm() / k1.norm());
       worst = std::max(worst, (p2 + k2).norm() / k2.norm());
     }
-    std::printf("%s: deformation 1e-8: worst relative |P - K delta| = %.2e, |delta - imposed| = %.2e\n",
-                name(f), worst, worst_delta);
+    std::printf(
+        "%s: deformation 1e-8: worst relative |P - K delta| = %.2e, |delta - imposed| = %.2e\n",
+        name(f), worst, worst_delta);
     EXPECT_LT(worst, 1e-6) << name(f);
     EXPECT_LT(worst_delta, 1e-6) << name(f);
   }
@@ -206,15 +208,17 @@ TEST(Beam, AutomaticDifferentiationJacobianMatchesCentralDifferences) {
       s.b2.v = rng.vec3(1.0), s.b2.omega = rng.vec3(2.0);
       const auto kernel = [&s](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
                                Vec6T<Ad12>& w2) { beam_wrenches(s.beam, b1, b2, w1, w2); };
-      const Mat12 ad_x = element_jacobian(seed_configuration(s.b1, 0), seed_configuration(s.b2, 6), kernel);
+      const Mat12 ad_x =
+          element_jacobian(seed_configuration(s.b1, 0), seed_configuration(s.b2, 6), kernel);
       const Mat12 ad_v = element_jacobian(seed_velocity(s.b1, 0), seed_velocity(s.b2, 6), kernel);
       const Mat12 fd_x = fd_configuration(s.beam, s.b1, s.b2, 1e-6);
       const Mat12 fd_v = fd_velocity(s.beam, s.b1, s.b2, 1e-4);
       worst_x = std::max(worst_x, (ad_x - fd_x).cwiseAbs().maxCoeff() / ad_x.cwiseAbs().maxCoeff());
       worst_v = std::max(worst_v, (ad_v - fd_v).cwiseAbs().maxCoeff() / ad_v.cwiseAbs().maxCoeff());
     }
-    std::printf("%s: AD vs central FD, worst relative difference: configuration %.2e, velocity %.2e\n",
-                name(f), worst_x, worst_v);
+    std::printf(
+        "%s: AD vs central FD, worst relative difference: configuration %.2e, velocity %.2e\n",
+        name(f), worst_x, worst_v);
     EXPECT_LT(worst_x, 1e-6) << name(f);
     EXPECT_LT(worst_v, 1e-6) << name(f);
   }
@@ -235,13 +239,15 @@ TEST(Beam, EnergyFormulationWrenchesAreTheNegativeEnergyGradient) {
       (k % 6 < 3 ? dc : th)(k % 3) = h;
       const bool first = k < 6;
       const double up = evaluate(s.beam, first ? testing::perturbed(s.b1, dc, th) : s.b1,
-                                 first ? s.b2 : testing::perturbed(s.b2, dc, th)).energy;
+                                 first ? s.b2 : testing::perturbed(s.b2, dc, th))
+                            .energy;
       const double down = evaluate(s.beam, first ? testing::perturbed(s.b1, -dc, -th) : s.b1,
-                                   first ? s.b2 : testing::perturbed(s.b2, -dc, -th)).energy;
+                                   first ? s.b2 : testing::perturbed(s.b2, -dc, -th))
+                              .energy;
       gradient(k) = (up - down) / (2 * h);
     }
-    worst = std::max(worst, (generalized + gradient).cwiseAbs().maxCoeff() /
-                                generalized.cwiseAbs().maxCoeff());
+    worst = std::max(
+        worst, (generalized + gradient).cwiseAbs().maxCoeff() / generalized.cwiseAbs().maxCoeff());
   }
   std::printf("energy: worst relative |Q + dU/dX| = %.2e\n", worst);
   EXPECT_LT(worst, 1e-6);

@@ -59,8 +59,8 @@ TEST(Dynamics, ExactJacobianMatchesCentralDifferences) {
   testing::Random rng(5);
   for (int k = 0; k < model.n_free(); ++k) {
     y.segment<3>(13 * k) += rng.vec3(2e-3);
-    y.segment<4>(13 * k + 3) += Vec4(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1),
-                                     rng.uniform(-1, 1)) * 1e-2;
+    y.segment<4>(13 * k + 3) +=
+        Vec4(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)) * 1e-2;
   }
   const double t = 0.3;
   std::vector<Mat13> blocks;

@@ -10,7 +10,8 @@ namespace {
 TEST(Rotation, MatrixIsProperOrthogonalAndMatchesQuaternionProduct) {
   testing::Random rng(1);
   for (int i = 0; i < 100; ++i) {
-    const Vec4 q = Vec4(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    const Vec4 q =
+        Vec4(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
     const Mat3 a = rotation_matrix<double>(q);
     EXPECT_LT((a * a.transpose() - Mat3::Identity()).norm(), 1e-14);
     EXPECT_NEAR(a.determinant(), 1.0, 1e-14);
@@ -47,7 +48,8 @@ TEST(Rotation, IncrementJacobianMatchesFiniteDifferences) {
       Vec4 qp = q, qm = q;
       qp(k) += h, qm(k) -= h;
       // exp([theta]x) = A(q + dq) A(q)^T to first order: theta from the skew part.
-      const Mat3 d = (rotation_matrix<double>(qp) - rotation_matrix<double>(qm)) / (2 * h) * a.transpose();
+      const Mat3 d =
+          (rotation_matrix<double>(qp) - rotation_matrix<double>(qm)) / (2 * h) * a.transpose();
       const Vec3 theta(d(2, 1), d(0, 2), d(1, 0));
       EXPECT_LT((theta - jac.col(k)).norm(), 1e-7 * (1.0 + jac.col(k).norm()));
     }

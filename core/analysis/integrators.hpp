@@ -1,0 +1,36 @@
+// The time integrators of the transient analysis behind one small interface: CVODE (BDF, Adams)
+// and ARKODE (diagonally implicit Runge-Kutta tables, explicit Runge-Kutta tables), with dense or
+// sparse (KLU) linear algebra for the implicit ones.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/analysis/ode_system.hpp"
+#include "core/analysis/sundials_support.hpp"
+#include "core/analysis/transient.hpp"
+
+namespace beamrail {
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  // Integrates to tout without stepping past tstop; y and *t receive the result. Returns a
+  // SUNDIALS flag (< 0: failure).
+  virtual int advance(double tout, double tstop, N_Vector y, double* t) = 0;
+  // Restarts from (t, y) after a jump in the loads.
+  virtual void restart(double t, N_Vector y) = 0;
+  virtual SolverStats stats() const = 0;
+  // A sentence on why advance() returned flag.
+  virtual std::string failure(int flag) const = 0;
+  // "dense", "sparse" or "none" (explicit methods).
+  std::string linear_solver = "none";
+  int nnz = 0;  // stored Jacobian entries (sparse)
+};
+
+// Builds the integrator of options.method for the system in `context`, starting at (0, y0).
+// Returns nullptr with *error set when an option is unusable.
+std::unique_ptr<Integrator> make_integrator(const IntegratorOptions& options, OdeContext& context,
+                                            SUNContext sunctx, N_Vector y0, std::string* error);
+
+}  // namespace beamrail

@@ -9,6 +9,10 @@ const std::vector<std::string> kAnalysisTypes = {"transient", "static", "modal"}
 
 namespace {
 
+bool read_transient(ObjectReader& r, AnalysisSpec& a);
+
+}  // namespace
+
 void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
                      IntegratorOptions& io) {
   ObjectReader r(value, where, diag);
@@ -28,7 +32,8 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
     io.linear_solver = *s == "dense"    ? LinearSolverKind::kDense
                        : *s == "sparse" ? LinearSolverKind::kSparse
                                         : LinearSolverKind::kAuto;
-  if (io.jacobian == JacobianKind::kFiniteDifference && io.linear_solver == LinearSolverKind::kSparse)
+  if (io.jacobian == JacobianKind::kFiniteDifference &&
+      io.linear_solver == LinearSolverKind::kSparse)
     r.error("jacobian", "finite-difference Jacobians need the dense linear solver");
   if (const auto q = r.integer("max_order", false, 1)) {
     const int limit = io.method == "adams" ? 12 : 5;
@@ -40,8 +45,7 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
       io.max_order = static_cast<int>(*q);
   }
   if (const auto d = r.boolean("stability_limit_detection", false)) {
-    if (io.method != "bdf")
-      r.error("stability_limit_detection", "applies to the \"bdf\" method");
+    if (io.method != "bdf") r.error("stability_limit_detection", "applies to the \"bdf\" method");
     io.stability_limit_detection = *d;
   }
   io.max_step = r.positive("max_step", false).value_or(0.0);
@@ -49,11 +53,15 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
 }
 
+namespace {
+
 bool read_transient(ObjectReader& r, AnalysisSpec& a) {
   const auto t_end = r.positive("t_end", true);
   const auto step = r.positive("output_step", false);
   if (const Json* i = r.member("integrator", false))
     read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
+  a.verify = r.boolean("verify", false).value_or(false);
+  a.transient.max_seconds = r.positive("max_seconds", false).value_or(0.0);
   if (!t_end) return false;
   a.transient.t_end = *t_end;
   a.transient.output_step = step.value_or(*t_end / 100.0);
@@ -135,7 +143,7 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   a.where = where;
   const auto type = r.choice("type", true, kAnalysisTypes);
   if (!type) {
-    r.allow({"t_end", "output_step", "integrator", "time", "load_steps", "tolerance",
+    r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "time", "load_steps", "tolerance",
              "max_iterations", "modes", "about", "solver"});
     return std::nullopt;
   }

@@ -253,6 +253,53 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
   p.gradient_step = r.positive("gradient_step", false).value_or(p.gradient_step);
 }
 
+void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
+  WorkPrecisionPlan& p = d.work_precision;
+  if (find_analysis(study, AnalysisSpec::Type::kTransient) < 0 &&
+      study.document.contains("analyses"))
+    r.error("type", "a work-precision study needs a transient analysis in \"analyses\"");
+  if (const Json* methods = r.member("methods", true)) {
+    if (!methods->is_array() || methods->empty()) {
+      r.error("methods", "expected a non-empty array of integrator settings");
+    } else {
+      for (size_t i = 0; i < methods->size(); ++i) {
+        const Where at = r.at("methods") / i;
+        const Json& m = (*methods)[i];
+        if (m.is_object() && (m.contains("rtol") || m.contains("atol"))) {
+          r.diagnostics().error(at.file, at.pointer,
+                                "tolerances come from \"rtols\" and \"atol_scale\"");
+          continue;
+        }
+        WorkPrecisionPlan::Method method;
+        read_integrator(m, at, r.diagnostics(), method.integrator);
+        const IntegratorOptions& io = method.integrator;
+        method.label = io.method;
+        if (!io.table.empty()) method.label.append(" ").append(io.table);
+        if (m.is_object() && m.contains("max_order"))
+          method.label.append(" order<=").append(std::to_string(io.max_order));
+        if (io.linear_solver != LinearSolverKind::kAuto)
+          method.label.append(io.linear_solver == LinearSolverKind::kDense ? " dense" : " sparse");
+        p.methods.push_back(method);
+      }
+    }
+  }
+  if (const auto rtols = r.numbers("rtols", true, -1)) {
+    for (size_t i = 0; i < rtols->size(); ++i)
+      if (!((*rtols)[i] > 0.0)) {
+        const Where at = r.at("rtols") / i;
+        r.diagnostics().error(at.file, at.pointer, "tolerances must be > 0");
+      }
+    p.rtols = *rtols;
+  }
+  p.atol_scale = r.positive("atol_scale", false).value_or(p.atol_scale);
+  p.reference.rtol = 1e-11;
+  p.reference.atol = 1e-12;
+  if (const Json* reference = r.member("reference", false))
+    read_integrator(*reference, r.at("reference"), r.diagnostics(), p.reference);
+  p.max_seconds = r.positive("max_seconds", false).value_or(p.max_seconds);
+  p.target_error = r.positive("target_error", false).value_or(p.target_error);
+}
+
 }  // namespace
 
 std::optional<DesignStudy> read_design_study(const Json& value, const Where& where,
@@ -262,12 +309,35 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
   {
     ObjectReader r(value, where, diag);
     if (!r.is_object()) return std::nullopt;
-    const auto type = r.choice("type", true, {"sweep", "optimize"});
+    const auto type = r.choice("type", true, {"sweep", "optimize", "work_precision"});
     if (!type) {
-      r.allow({"variables", "sampling", "samples", "seed", "rows", "objective", "constraints",
-               "algorithm", "local_algorithm", "max_evaluations", "xtol_rel", "ftol_rel",
-               "max_seconds", "starts", "gradient_step"});
+      r.allow({"variables",
+               "sampling",
+               "samples",
+               "seed",
+               "rows",
+               "objective",
+               "constraints",
+               "algorithm",
+               "local_algorithm",
+               "max_evaluations",
+               "xtol_rel",
+               "ftol_rel",
+               "max_seconds",
+               "starts",
+               "gradient_step",
+               "methods",
+               "rtols",
+               "atol_scale",
+               "reference",
+               "target_error",
+               "max_seconds_per_design"});
       return std::nullopt;
+    }
+    if (*type == "work_precision") {
+      d.type = DesignStudy::Type::kWorkPrecision;
+      read_work_precision(r, study, d);
+      return diag.size() > errors_before ? std::nullopt : std::optional<DesignStudy>(d);
     }
     d.type = *type == "sweep" ? DesignStudy::Type::kSweep : DesignStudy::Type::kOptimize;
     if (d.type == DesignStudy::Type::kSweep) {
@@ -293,6 +363,7 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
         d.variables.push_back(*v);
       }
     }
+    d.max_seconds_per_design = r.positive("max_seconds_per_design", false).value_or(0.0);
     if (d.type == DesignStudy::Type::kSweep)
       read_sweep(r, study, d);
     else

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/analysis/transient.hpp"
 #include "core/scene/json_reader.hpp"
 
 namespace beamrail {
@@ -51,12 +52,31 @@ struct OptimizePlan {
   double gradient_step = 1e-6;  // central differences: h = step * (upper - lower)
 };
 
+// The measured speed-accuracy trade of the study's transient analysis: every method at every
+// tolerance against a tight reference run.
+struct WorkPrecisionPlan {
+  struct Method {
+    std::string label;  // as shown in the table, e.g. "dirk ARK548L2SA_DIRK_8_4_5"
+    IntegratorOptions integrator;
+  };
+  std::vector<Method> methods;
+  std::vector<double> rtols;
+  double atol_scale = 1e-4;     // atol = atol_scale * rtol
+  IntegratorOptions reference;  // default: bdf at rtol 1e-11, atol 1e-12
+  double max_seconds = 60.0;    // budget per run; a slower run is a timeout row
+  double target_error = 1e-6;   // the cheapest run meeting it is named in the summary
+};
+
 struct DesignStudy {
-  enum class Type { kSweep, kOptimize };
+  enum class Type { kSweep, kOptimize, kWorkPrecision };
   Type type = Type::kSweep;
   std::vector<DesignVariable> variables;
   SweepPlan sweep;
   OptimizePlan optimize;
+  WorkPrecisionPlan work_precision;
+  // Wall-clock budget of one design's evaluation [s]; 0: none. A design still running when it is
+  // spent becomes a "timeout" row.
+  double max_seconds_per_design = 0.0;
 };
 
 struct Study;

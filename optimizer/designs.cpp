@@ -37,7 +37,9 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x) const {
         out.message += d.pointer + ": " + d.message;
       }
     } else {
-      const Evaluation ev = beamrail::evaluate(*design, design->model, EvaluationOptions{});
+      EvaluationOptions options;
+      options.max_seconds = study_.design->max_seconds_per_design;
+      const Evaluation ev = beamrail::evaluate(*design, design->model, options);
       out.status = ev.status;
       out.message = ev.message;
       out.responses = ev.responses;

@@ -11,7 +11,7 @@
 namespace beamrail {
 
 struct DesignOutcome {
-  std::string status = "ok";  // ok | failed | invalid
+  std::string status = "ok";  // ok | failed | timeout | invalid
   std::string message;
   std::vector<double> responses;  // one per study.responses (NaN when not computed)
   double wall_seconds = 0.0;

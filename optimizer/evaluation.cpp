@@ -7,6 +7,7 @@
 
 #include "optimizer/responses.hpp"
 #include "optimizer/result_tables.hpp"
+#include "optimizer/trajectory.hpp"
 
 namespace beamrail {
 namespace {
@@ -15,8 +16,14 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 class Runner {
  public:
-  Runner(const Study& study, const Model& model, const EvaluationOptions& options, Evaluation& ev)
-      : study_(study), model_(model), options_(options), ev_(ev), static_data_(model) {}
+  Runner(const Study& study, const Model& model, const EvaluationOptions& options, Evaluation& ev,
+         std::chrono::steady_clock::time_point start)
+      : study_(study),
+        model_(model),
+        options_(options),
+        ev_(ev),
+        static_data_(model),
+        start_(start) {}
 
   // Runs one analysis; false when it failed (the evaluation then stops).
   bool run(const AnalysisSpec& spec) {
@@ -34,7 +41,7 @@ class Runner {
     }
     const bool ok = report.ok;
     if (!ok) {
-      ev_.status = "failed";
+      ev_.status = report.timed_out ? "timeout" : "failed";
       ev_.message = report.type + " analysis: " + report.message;
     }
     ev_.analyses.push_back(std::move(report));
@@ -125,6 +132,7 @@ class Runner {
     if (!options_.output_directory.empty())
       table.open(options_.output_directory / "timeseries.csv", model_, &table_error);
 
+    Trajectory trajectory = trajectory_of(model_);
     bool first = true;
     double scale = 0.0;
     const auto observer = [&](const TransientSample& s, const Data& d) {
@@ -138,12 +146,18 @@ class Runner {
       for (auto& [k, t] : peaks)
         ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
       if (table.good()) table.write(s, d);
+      if (spec.verify) trajectory.record(s, d);
     };
-    const TransientResult result = run_transient(model_, spec.transient, data, observer);
+    const TransientOptions options = budgeted(spec.transient);
+    const TransientResult result = run_transient(model_, options, data, observer);
     table.flush();
     report.ok = result.ok;
+    report.timed_out = result.timed_out;
     report.message = result.message;
     report.stats = result.stats;
+    report.integrator = options.integrator.method;
+    if (!options.integrator.table.empty()) report.integrator += " " + options.integrator.table;
+    report.linear_solver = result.linear_solver;
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);
@@ -153,7 +167,40 @@ class Runner {
     }
     if (!result.ok)
       for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
+    if (result.ok && spec.verify) report.verification = verify(options, trajectory);
     return report;
+  }
+
+  // The run's options with max_seconds cut to what is left of the evaluation's budget.
+  TransientOptions budgeted(TransientOptions options) const {
+    if (options_.max_seconds > 0.0) {
+      const double used =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      const double left = std::max(1e-3, options_.max_seconds - used);
+      options.max_seconds = options.max_seconds > 0.0 ? std::min(options.max_seconds, left) : left;
+    }
+    return options;
+  }
+
+  // Reruns the transient at rtol and atol divided by ten and measures how far the run was from it.
+  Verification verify(const TransientOptions& options, const Trajectory& run) const {
+    Verification v;
+    TransientOptions tight = budgeted(options);
+    tight.integrator.rtol /= 10.0;
+    tight.integrator.atol /= 10.0;
+    v.rtol = tight.integrator.rtol;
+    v.atol = tight.integrator.atol;
+    Data data(model_);
+    Trajectory reference = trajectory_of(model_);
+    const TransientResult r =
+        run_transient(model_, tight, data, [&reference](const TransientSample& s, const Data& d) {
+          reference.record(s, d);
+        });
+    v.ok = r.ok;
+    v.message = r.message;
+    v.stats = r.stats;
+    v.error = r.ok ? trajectory_error(run, reference) : kNaN;
+    return v;
   }
 
   void add_warnings(const std::vector<std::string>& warnings) {
@@ -169,6 +216,7 @@ class Runner {
   Data static_data_;
   StaticOptions static_options_;
   std::optional<StaticResult> static_result_;
+  std::chrono::steady_clock::time_point start_;
 };
 
 }  // namespace
@@ -181,7 +229,7 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
     for (size_t k = 0; k < study.responses.size(); ++k)
       if (study.responses[k].quantity == ResponseSpec::Quantity::kMass)
         ev.responses[k] = structural_mass(model);
-    Runner runner(study, model, options, ev);
+    Runner runner(study, model, options, ev, start);
     for (const AnalysisSpec& spec : study.analyses)
       if (!runner.run(spec)) break;
   } catch (const std::exception& e) {

@@ -14,17 +14,30 @@
 
 namespace beamrail {
 
+// A transient rerun at tolerances ten times tighter: the error the run achieved beside its cost.
+struct Verification {
+  bool ok = false;
+  std::string message;
+  double rtol = 0.0, atol = 0.0;  // of the tighter run
+  double error = 0.0;  // largest body-centre distance between the runs / largest motion
+  SolverStats stats;   // of the tighter run
+};
+
 struct AnalysisReport {
   std::string type;  // "transient", "static", "modal"
   bool ok = false;
+  bool timed_out = false;  // stopped by a max_seconds budget
   std::string message;
   double wall_seconds = 0.0;
   // transient
   SolverStats stats;
+  std::string integrator;     // method, and table if any
+  std::string linear_solver;  // dense | sparse | none
   double t_reached = 0.0;                   // [s]
   double energy_initial = 0.0;              // total energy at t = 0 [J]
   double energy_final = 0.0;                // at the last sample [J]
   double energy_max_relative_change = 0.0;  // max |E - E0| / energy scale
+  std::optional<Verification> verification;
   // static (also the equilibrium a modal analysis was linearized about)
   std::optional<StaticResult> statics;
   // modal
@@ -35,7 +48,7 @@ struct AnalysisReport {
 };
 
 struct Evaluation {
-  std::string status = "ok";  // ok | failed | invalid
+  std::string status = "ok";  // ok | failed | timeout | invalid
   std::string message;
   std::vector<double> responses;  // one per study.responses, NaN when not computed
   std::vector<AnalysisReport> analyses;
@@ -45,6 +58,9 @@ struct Evaluation {
 
 struct EvaluationOptions {
   std::filesystem::path output_directory;  // empty: write no tables (batch evaluations)
+  // Wall-clock budget of the whole evaluation [s]; 0: none. A transient still running when it is
+  // spent stops, and the evaluation's status is "timeout".
+  double max_seconds = 0.0;
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed

@@ -23,6 +23,7 @@ struct AnalysisSpec {
   StaticOptions statics;
   ModalOptions modal;
   bool about_static = false;  // modal: linearize about the static equilibrium (else: initial)
+  bool verify = false;  // transient: rerun at tolerances ten times tighter and report the error
   Where where;
 };
 
@@ -86,6 +87,10 @@ extern const std::vector<std::string> kResponseQuantities;
 // errors) lets the defaults depend on the scene.
 std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where, const Model* model,
                                           Diagnostics& diag);
+
+// Reads an "integrator" object into io (analysis_specs.cpp).
+void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
+                     IntegratorOptions& io);
 
 // Reads one named response (response_specs.cpp); model may be null when the scene has errors.
 std::optional<ResponseSpec> read_response(const std::string& name, const Json& value,

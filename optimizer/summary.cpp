@@ -39,10 +39,12 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
   nlohmann::json analyses = nlohmann::json::array();
   for (const AnalysisReport& a : ev.analyses) {
     nlohmann::json j{{"type", a.type},
-                     {"status", a.ok ? "ok" : "failed"},
+                     {"status", a.ok ? "ok" : a.timed_out ? "timeout" : "failed"},
                      {"message", a.message},
                      {"wall_seconds", a.wall_seconds}};
     if (a.type == "transient") {
+      j["integrator"] = a.integrator;
+      j["linear_solver"] = a.linear_solver;
       j["steps"] = a.stats.steps;
       j["rhs_evaluations"] = a.stats.rhs_evaluations;
       j["jacobian_evaluations"] = a.stats.jacobian_evaluations;
@@ -53,6 +55,20 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["energy_initial"] = json_number(a.energy_initial);
       j["energy_final"] = json_number(a.energy_final);
       j["energy_max_relative_change"] = json_number(a.energy_max_relative_change);
+      if (const auto& v = a.verification)
+        j["verification"] = {
+            {"status", v->ok ? "ok" : "failed"},
+            {"message", v->message},
+            {"rtol", v->rtol},
+            {"atol", v->atol},
+            {"error", json_number(v->error)},
+            {"error_measure",
+             "largest distance between body centres of the run and of the tighter run, relative "
+             "to the largest distance a body moved"},
+            {"wall_seconds", v->stats.wall_seconds},
+            {"steps", v->stats.steps},
+            {"rhs_evaluations", v->stats.rhs_evaluations},
+            {"jacobian_evaluations", v->stats.jacobian_evaluations}};
     }
     if (a.statics) {
       const StaticResult& r = *a.statics;

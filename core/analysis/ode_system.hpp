@@ -6,6 +6,7 @@
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_matrix.h>
 
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ struct OdeContext {
   std::vector<Mat13> blocks;
   JacobianPattern pattern;     // filled when the sparse solver is used
   std::string callback_error;  // an exception caught inside a callback
+  // Wall-clock budget: past this moment the right-hand side fails unrecoverably.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  bool timed_out = false;
 };
 
 // SUNDIALS callbacks; user_data is an OdeContext*.

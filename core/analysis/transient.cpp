@@ -44,6 +44,9 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   try {
     SundialsContext ctx;
     OdeContext context(model, data);
+    if (options.max_seconds > 0.0)
+      context.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                     std::chrono::duration<double>(options.max_seconds));
     const long n = model.n_states;
     SerialVector y(n, ctx);
     initial_state(model, y.data());
@@ -79,6 +82,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
         const int flag = integrator->advance(std::min(t_out, stop), stop, y, &t);
         if (flag < 0) {
           result.ok = false;
+          result.timed_out = context.timed_out;
           result.message = integrator->failure(flag);
           break;
         }

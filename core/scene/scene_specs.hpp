@@ -70,8 +70,9 @@ struct SceneSpecs {
   std::vector<Vec3> load_points;  // global application point of each load
 };
 
-// More segments than this would only exhaust memory (every one adds a body and 13 states).
-constexpr long kMaxSegments = 1000;
+// More segments than this would only exhaust memory and time (every one adds a body and 13
+// states; 1e5 segments load in well under a second).
+constexpr long kMaxSegments = 100000;
 
 // Readers for each part of a scene; each reports its own problems.
 void read_materials(ObjectReader& scene, SceneSpecs& specs);

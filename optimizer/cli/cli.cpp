@@ -8,11 +8,12 @@
 
 #include "optimizer/evaluation.hpp"
 #include "optimizer/optimize.hpp"
-#include "optimizer/sweep.hpp"
 #include "optimizer/study.hpp"
 #include "optimizer/summary.hpp"
+#include "optimizer/sweep.hpp"
 #include "optimizer/tables.hpp"
 #include "optimizer/version.hpp"
+#include "optimizer/work_precision.hpp"
 
 namespace beamrail {
 namespace {
@@ -130,9 +131,16 @@ int run(const RunArguments& args) {
   }
 
   const RunSettings settings{out, args.threads, args.resume, args.quiet};
-  if (study->design)
-    return study->design->type == DesignStudy::Type::kSweep ? run_sweep(*study, settings)
-                                                            : run_optimize(*study, settings);
+  if (study->design) {
+    switch (study->design->type) {
+      case DesignStudy::Type::kSweep:
+        return run_sweep(*study, settings);
+      case DesignStudy::Type::kOptimize:
+        return run_optimize(*study, settings);
+      case DesignStudy::Type::kWorkPrecision:
+        return run_work_precision(*study, settings);
+    }
+  }
 
   const Evaluation ev = evaluate(*study, study->model, {out});
   const nlohmann::json summary = evaluation_summary(*study, study->model, ev);

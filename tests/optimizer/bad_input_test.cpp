@@ -675,7 +675,7 @@ TEST_F(BadInput, PathologicalTextDoesNotCrash) {
 
 TEST_F(BadInput, TooManySegments) {
   EXPECT_TRUE(HasOnlyError(check(with("/scene/beams/0/segments", 1e8)),
-                           "bad.json:/scene/beams/0/segments:", "at most 1000 segments"));
+                           "bad.json:/scene/beams/0/segments:", "at most 100000 segments"));
 }
 
 TEST_F(BadInput, RunRejectsBadInputWithStatusTwo) {

@@ -1,0 +1,26 @@
+// Body trajectories of a transient run, kept to compare runs: the accuracy a run achieved against a
+// tighter one (work-precision studies, "verify").
+#pragma once
+
+#include <vector>
+
+#include "core/analysis/transient.hpp"
+
+namespace beamrail {
+
+struct Trajectory {
+  std::vector<int> bodies;      // the scene's own free bodies
+  std::vector<double> times;    // [s]
+  std::vector<Vec3> positions;  // centre of each body at each time, time-major
+  void record(const TransientSample& sample, const Data& data);
+};
+
+// Starts an empty trajectory of the model's scene bodies.
+Trajectory trajectory_of(const Model& model);
+
+// The largest distance between the runs' body centres over the common times, relative to the
+// largest distance a reference body moved from its start; NaN when the runs share no time or the
+// reference does not move.
+double trajectory_error(const Trajectory& run, const Trajectory& reference);
+
+}  // namespace beamrail

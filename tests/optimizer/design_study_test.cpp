@@ -649,5 +649,118 @@ TEST_F(DesignStudyRuns, VariableAtAMissingPathOrAtAStringIsBadInput) {
   }
 }
 
+// --- 7. The speed-accuracy trade: work-precision studies, "verify", budgets per design -----------
+
+// The reference problem of studies/work_precision_reference.json cut to 3 segments and 0.02 s.
+Json small_work_precision() {
+  Json s = load_json(kStudies / "work_precision_reference.json");
+  s["scene"]["beams"][0]["segments"] = 3;
+  s["analyses"][0]["t_end"] = 0.02;
+  s["analyses"][0]["output_step"] = 2e-4;
+  s["study"]["methods"] = Json::parse(R"([{"method": "bdf"}, {"method": "dirk"},
+                                          {"method": "erk", "table": "VERNER_8_5_6"}])");
+  s["study"]["rtols"] = Json{1e-4, 1e-7};
+  s["study"]["target_error"] = 1e-5;
+  return s;
+}
+
+TEST_F(DesignStudyRuns, WorkPrecisionStudyTabulatesEveryMethodAndToleranceAgainstTheReference) {
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", small_work_precision()), "wp"));
+  const Table t = read_table(dir_ / "wp" / "work_precision.csv");
+  const Json summary = load_json(dir_ / "wp" / "summary.json");
+  const std::vector<std::string> methods = {"bdf", "dirk", "erk VERNER_8_5_6"};
+  ASSERT_EQ(t.rows.size(), 6u);
+  double fastest = INFINITY;
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    const double error = std::stod(t.at(i, "error")), wall = std::stod(t.at(i, "wall_s"));
+    std::printf("%-18s rtol %s: error %.3g, %s steps, %s s\n", t.at(i, "method").c_str(),
+                t.at(i, "rtol").c_str(), error, t.at(i, "steps").c_str(), t.at(i, "wall_s").c_str());
+    EXPECT_EQ(t.at(i, "method"), methods[i / 2]);
+    EXPECT_EQ(std::stod(t.at(i, "rtol")), i % 2 ? 1e-7 : 1e-4);
+    EXPECT_EQ(std::stod(t.at(i, "atol")), std::stod(t.at(i, "rtol")) * 1e-4);
+    EXPECT_EQ(t.at(i, "status"), "ok");
+    EXPECT_TRUE(std::isfinite(error) && error > 0.0) << i;
+    EXPECT_EQ(t.at(i, "jac_evals") == "0", methods[i / 2].rfind("erk", 0) == 0) << i;
+    if (error <= 1e-5) fastest = std::min(fastest, wall);
+  }
+  for (size_t i = 0; i < t.rows.size(); i += 2)  // a tighter tolerance is a smaller error
+    EXPECT_LT(std::stod(t.at(i + 1, "error")), std::stod(t.at(i, "error"))) << t.at(i, "method");
+  EXPECT_EQ(summary["type"], "work_precision");
+  EXPECT_EQ(summary["runs"], 6);
+  EXPECT_EQ(summary["failed_or_timeout"], 0);
+  EXPECT_EQ(summary["reference"]["rtol"], 1e-11);
+  ASSERT_TRUE(summary["fastest_within_target"].is_object()) << summary.dump(2);
+  EXPECT_LE(summary["fastest_within_target"]["error"].get<double>(), 1e-5);
+  EXPECT_EQ(summary["fastest_within_target"]["wall_seconds"].get<double>(), fastest);
+}
+
+TEST_F(DesignStudyRuns, WorkPrecisionRunsPastTheirBudgetAreTimeoutRows) {
+  Json s = small_work_precision();
+  s["study"]["max_seconds"] = 1e-6;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
+  const Table t = read_table(dir_ / "wp" / "work_precision.csv");
+  const Json summary = load_json(dir_ / "wp" / "summary.json");
+  ASSERT_EQ(t.rows.size(), 6u);
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    EXPECT_EQ(t.at(i, "status"), "timeout") << i;
+    EXPECT_EQ(t.at(i, "error"), "nan") << i;
+  }
+  EXPECT_EQ(summary["failed_or_timeout"], 6);
+  EXPECT_TRUE(summary["fastest_within_target"].is_null());
+}
+
+// "verify" measures a run against the same run at tolerances ten times tighter; the estimate must
+// agree with the error measured against a tight reference by the work-precision study.
+TEST_F(DesignStudyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightReference) {
+  Json wp = small_work_precision();
+  wp["study"]["methods"] = Json::parse(R"([{"method": "dirk"}])");
+  wp["study"]["rtols"] = Json{1e-6};
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp"));
+  const double measured = std::stod(read_table(dir_ / "wp" / "work_precision.csv").at(0, "error"));
+
+  Json single = wp;
+  single.erase("study");
+  single["analyses"][0]["integrator"] =
+      Json{{"method", "dirk"}, {"rtol", 1e-6}, {"atol", 1e-6 * 1e-4}};
+  single["analyses"][0]["verify"] = true;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("single.json", single), "single"));
+  const Json summary = load_json(dir_ / "single" / "summary.json");
+  const Json& v = summary["analyses"][0]["verification"];
+  ASSERT_TRUE(v.is_object()) << summary.dump(2);
+  EXPECT_EQ(v["status"], "ok");
+  EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-7);
+  EXPECT_DOUBLE_EQ(v["atol"].get<double>(), 1e-11);
+  EXPECT_GT(v["steps"].get<long>(), summary["analyses"][0]["steps"].get<long>());
+  const double estimate = v["error"];
+  std::printf("dirk rtol 1e-6: error %.4g against rtol 1e-11, %.4g against rtol 1e-7 (ratio %.3f)\n",
+              measured, estimate, estimate / measured);
+  // If the tighter run's own error is at most a third of the run's, the estimate lies within
+  // [2/3, 4/3] of the true error.
+  EXPECT_GT(estimate / measured, 2.0 / 3.0);
+  EXPECT_LT(estimate / measured, 4.0 / 3.0);
+}
+
+TEST_F(DesignStudyRuns, ADesignPastItsBudgetIsATimeoutRowAndTheBatchGoesOn) {
+  Json s = load_json(kStudies / "work_precision_reference.json");
+  s["analyses"][0]["t_end"] = 0.01;
+  s["analyses"][0]["output_step"] = 0.01;
+  s["analyses"][0]["integrator"] = Json{{"rtol", 1e-8}, {"atol", 1e-10}};
+  s["responses"] = Json::parse(R"({"mass": {"quantity": "mass"}})");
+  s["study"] = Json::parse(R"({"type": "sweep", "sampling": "list", "max_seconds_per_design": 2.0,
+      "variables": [{"name": "t_end", "pointer": "/analyses/0/t_end"}],
+      "rows": [[0.01], [1000.0], [0.02]]})");
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("budget.json", s), "out", {"-j", "1"}));
+  const Table t = read_table(dir_ / "out" / "samples.csv");
+  ASSERT_EQ(t.rows.size(), 3u);
+  const std::vector<std::string> expected = {"ok", "timeout", "ok"};
+  for (size_t i = 0; i < 3; ++i) {
+    std::printf("t_end %s: %s in %s s %s\n", t.at(i, "t_end").c_str(), t.at(i, "status").c_str(),
+                t.at(i, "wall_s").c_str(), t.at(i, "message").c_str());
+    EXPECT_EQ(t.at(i, "status"), expected[i]) << i;
+  }
+  EXPECT_NE(t.at(1, "message").find("max_seconds"), std::string::npos) << t.at(1, "message");
+  EXPECT_GE(std::stod(t.at(1, "wall_s")), 2.0);
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -1,0 +1,170 @@
+// The integrator families (CVODE bdf/adams, ARKODE dirk/erk), the linear solvers (dense, sparse
+// KLU) and the Jacobian kinds (exact, finite differences) must all integrate the same motion: each
+// is compared with a tight reference run on a segmented cantilever hit by a step load. Also: the
+// automatic choice of the linear solver, and the wall-clock budget ending a run as a timeout.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "tests/support/transient_run.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::options;
+using testing::scene_from_json;
+using testing::simulate;
+using testing::TransientRun;
+
+// A 1 m steel cantilever of 10 mm square section in `segments` segments with a 1 N step load on
+// its tip body: every bending, axial and rotary mode of the chain is excited.
+std::string cantilever(int segments) {
+  return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "tip", "position": [1, 0, 0]}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
+               "segments": )" +
+         std::to_string(segments) + R"(}],
+    "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0],
+               "time": {"type": "step", "at": 0.0}}]})";
+}
+
+// Largest distance of the tip body from its reference position over the common samples,
+// relative to the largest tip motion in the reference.
+double tip_error(const TransientRun& run, const TransientRun& reference, int tip) {
+  double error = 0.0, motion = 0.0;
+  const Vec3 start = reference.samples.front().pose[tip].c;
+  for (const auto& s : reference.samples) motion = std::max(motion, (s.pose[tip].c - start).norm());
+  const size_t n = std::min(run.samples.size(), reference.samples.size());
+  for (size_t k = 0; k < n; ++k)
+    error = std::max(error, (run.samples[k].pose[tip].c - reference.samples[k].pose[tip].c).norm());
+  return error / motion;
+}
+
+int body_index(const Model& model, const std::string& name) {
+  for (size_t i = 0; i < model.bodies.size(); ++i)
+    if (model.bodies[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+struct Family {
+  const char* label;
+  const char* method;
+  const char* table;
+  LinearSolverKind solver;
+  JacobianKind jacobian;
+  int max_order;
+};
+
+TEST(Integrators, EveryFamilyIntegratesTheSameMotion) {
+  const Model model = scene_from_json(cantilever(4));
+  const int tip = body_index(model, "tip");
+  ASSERT_GE(tip, 0);
+  TransientOptions tight = options(0.05, 5e-4, 1e-11, 1e-12);
+  const TransientRun reference = simulate(model, tight);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  ASSERT_EQ(reference.samples.size(), 101u);
+
+  const Family families[] = {
+      {"bdf dense", "bdf", "", LinearSolverKind::kDense, JacobianKind::kExact, 5},
+      {"bdf sparse", "bdf", "", LinearSolverKind::kSparse, JacobianKind::kExact, 5},
+      {"bdf dense fd", "bdf", "", LinearSolverKind::kDense, JacobianKind::kFiniteDifference, 5},
+      {"bdf order<=2", "bdf", "", LinearSolverKind::kAuto, JacobianKind::kExact, 2},
+      {"adams", "adams", "", LinearSolverKind::kAuto, JacobianKind::kExact, 12},
+      {"dirk default", "dirk", "", LinearSolverKind::kAuto, JacobianKind::kExact, 5},
+      {"dirk TRBDF2", "dirk", "TRBDF2_3_3_2", LinearSolverKind::kAuto, JacobianKind::kExact, 5},
+      {"dirk ESDIRK547", "dirk", "ESDIRK547L2SA2_7_4_5", LinearSolverKind::kDense,
+       JacobianKind::kExact, 5},
+      {"erk default", "erk", "", LinearSolverKind::kAuto, JacobianKind::kExact, 5},
+      {"erk VERNER", "erk", "VERNER_8_5_6", LinearSolverKind::kAuto, JacobianKind::kExact, 5},
+  };
+  for (const Family& f : families) {
+    TransientOptions o = options(0.05, 5e-4, 1e-8, 1e-10);
+    o.integrator.method = f.method;
+    o.integrator.table = f.table;
+    o.integrator.linear_solver = f.solver;
+    o.integrator.jacobian = f.jacobian;
+    o.integrator.max_order = f.max_order;
+    const TransientRun run = simulate(model, o);
+    ASSERT_TRUE(run.result.ok) << f.label << ": " << run.result.message;
+    ASSERT_EQ(run.samples.size(), reference.samples.size()) << f.label;
+    const double e = tip_error(run, reference, tip);
+    std::printf("%-16s error %.2e  steps %6ld  rhs %7ld  jac %5ld  solver %s\n", f.label, e,
+                run.result.stats.steps, run.result.stats.rhs_evaluations,
+                run.result.stats.jacobian_evaluations, run.result.linear_solver.c_str());
+    // rtol 1e-8 on positions of about 1 m allows local errors near 1e-8 m against a tip motion
+    // of about 1e-3 m: 1e-5 relative leaves room for error accumulation over the steps.
+    EXPECT_LT(e, 1e-5) << f.label;
+    if (std::string(f.method) == "erk") {
+      EXPECT_EQ(run.result.linear_solver, "none") << f.label;
+      EXPECT_EQ(run.result.stats.jacobian_evaluations, 0) << f.label;
+    } else if (std::string(f.method) != "adams") {
+      EXPECT_GT(run.result.stats.jacobian_evaluations, 0) << f.label;
+    }
+    if (f.solver == LinearSolverKind::kDense) {
+      EXPECT_EQ(run.result.linear_solver, "dense");
+    } else if (f.solver == LinearSolverKind::kSparse) {
+      EXPECT_EQ(run.result.linear_solver, "sparse");
+    }
+  }
+}
+
+// Dense LU and sparse KLU solve the same Newton systems: the runs differ only by rounding.
+TEST(Integrators, DenseAndSparseSolversGiveTheSameRun) {
+  const Model model = scene_from_json(cantilever(6));
+  const int tip = body_index(model, "tip");
+  TransientOptions o = options(0.02, 1e-3, 1e-7, 1e-10);
+  o.integrator.linear_solver = LinearSolverKind::kDense;
+  const TransientRun dense = simulate(model, o);
+  o.integrator.linear_solver = LinearSolverKind::kSparse;
+  const TransientRun sparse = simulate(model, o);
+  ASSERT_TRUE(dense.result.ok && sparse.result.ok);
+  EXPECT_EQ(sparse.result.linear_solver, "sparse");
+  // 6 bodies: 78 states; each body's 13x13 block couples only to its chain neighbours.
+  EXPECT_GT(sparse.result.jacobian_nonzeros, 0);
+  EXPECT_LT(sparse.result.jacobian_nonzeros, 78 * 78 / 2);
+  const double e = tip_error(sparse, dense, tip);
+  std::printf("dense vs sparse: %.2e relative, steps %ld vs %ld, nonzeros %ld\n", e,
+              dense.result.stats.steps, sparse.result.stats.steps,
+              sparse.result.jacobian_nonzeros);
+  // Both runs meet the same tolerances; rounding differences in the factorizations can change
+  // step sizes, so they agree to the integration accuracy (rtol 1e-7 on positions of about 1 m
+  // against a motion of about 1e-4 m), not bitwise.
+  EXPECT_LT(e, 1e-6);
+}
+
+TEST(Integrators, AutomaticLinearSolverSwitchesToSparseAtTheMeasuredSize) {
+  TransientOptions o = options(1e-3, 1e-3, 1e-6, 1e-9);
+  const Model one = scene_from_json(cantilever(1));  // 13 states
+  const Model two = scene_from_json(cantilever(2));  // 26 states
+  ASSERT_EQ(one.n_states, 13);
+  ASSERT_EQ(two.n_states, 26);
+  ASSERT_GE(two.n_states, kSparseStateThreshold);
+  ASSERT_LT(one.n_states, kSparseStateThreshold);
+  EXPECT_EQ(simulate(one, o).result.linear_solver, "dense");
+  EXPECT_EQ(simulate(two, o).result.linear_solver, "sparse");
+}
+
+TEST(Integrators, WallClockBudgetEndsARunAsATimeoutAndKeepsItsSamples) {
+  const Model model = scene_from_json(cantilever(10));
+  TransientOptions o = options(100.0, 1e-3, 1e-10, 1e-12);  // hours of work at this tolerance
+  o.max_seconds = 0.2;
+  const TransientRun run = simulate(model, o);
+  EXPECT_FALSE(run.result.ok);
+  EXPECT_TRUE(run.result.timed_out);
+  EXPECT_NE(run.result.message.find("timeout"), std::string::npos) << run.result.message;
+  EXPECT_GT(run.result.t_reached, 0.0);
+  EXPECT_LT(run.result.t_reached, 100.0);
+  // Every output time reached was delivered, and nothing beyond.
+  ASSERT_GE(run.samples.size(), 1u);
+  EXPECT_LE(run.samples.back().sample.t, run.result.t_reached + 1e-12);
+  EXPECT_GE(run.result.stats.wall_seconds, 0.2);
+  std::printf("budget 0.2 s: stopped after %.3f s at t = %.4f s with %zu samples\n",
+              run.result.stats.wall_seconds, run.result.t_reached, run.samples.size());
+}
+
+}  // namespace
+}  // namespace beamrail

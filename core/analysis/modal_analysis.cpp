@@ -19,8 +19,9 @@ namespace {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 // Classifies eigenpairs, normalizes shapes, and keeps the rigid modes plus `wanted` others.
+// scales(i): the spectrum scale eigenvalue i is compared with to recognise a rigid mode.
 void classify(const Eigen::VectorXd& values, const Eigen::MatrixXd& vectors, const SparseMatrix& m,
-              double scale, int wanted, ModalResult& result) {
+              const Eigen::VectorXd& scales, int wanted, ModalResult& result) {
   std::vector<int> order(values.size());
   for (int i = 0; i < static_cast<int>(order.size()); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](int a, int b) { return values(a) < values(b); });
@@ -28,7 +29,7 @@ void classify(const Eigen::VectorXd& values, const Eigen::MatrixXd& vectors, con
   for (int i : order) {
     Mode mode;
     mode.eigenvalue = values(i);
-    if (std::abs(values(i)) <= kRigidModeThreshold * scale) {
+    if (std::abs(values(i)) <= kRigidModeThreshold * scales(i)) {
       mode.kind = Mode::Kind::kRigid;
       ++result.rigid_modes;
     } else if (values(i) < 0.0) {
@@ -54,15 +55,93 @@ void classify(const Eigen::VectorXd& values, const Eigen::MatrixXd& vectors, con
           "buckling or an unstable equilibrium)");
 }
 
-bool solve_dense(const SparseMatrix& k, const SparseMatrix& m, int wanted, ModalResult& result) {
-  const Eigen::MatrixXd kd(k), md(m);
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(kd, md);
-  if (eig.info() != Eigen::Success) {
-    result.message = "the dense eigensolver failed";
-    return false;
+// Groups of free bodies coupled by stiffness (the mass matrix is block-diagonal per body): their
+// eigenproblems are independent. Each group's degrees of freedom, ascending.
+std::vector<std::vector<int>> coupled_groups(const Model& model) {
+  const int n = model.n_free();
+  std::vector<int> parent(n);
+  for (int i = 0; i < n; ++i) parent[i] = i;
+  const auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const auto& b : model.pattern.blocks) parent[root(b.row)] = root(b.col);
+  std::vector<std::vector<int>> groups;
+  std::vector<int> slot(n, -1);
+  for (int i = 0; i < n; ++i) {
+    int& g = slot[root(i)];
+    if (g < 0) {
+      g = static_cast<int>(groups.size());
+      groups.emplace_back();
+    }
+    for (int d = 0; d < kDofsPerBody; ++d) groups[g].push_back(kDofsPerBody * i + d);
   }
-  const double scale = eig.eigenvalues().cwiseAbs().maxCoeff();
-  classify(eig.eigenvalues(), eig.eigenvectors(), m, scale, wanted, result);
+  return groups;
+}
+
+// Dense solution of one group, K x = w^2 M x. Eigenvalues come out accurate to ~eps lambda_max
+// absolute, so when the spectrum spans many decades and K is positive definite (no rigid modes),
+// the lower half is taken from the inverse problem M x = (1/w^2) K x, accurate to ~eps lambda_min.
+bool solve_group(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& md, Eigen::VectorXd& values,
+                 Eigen::MatrixXd& vectors) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(kd, md);
+  if (eig.info() != Eigen::Success) return false;
+  values = eig.eigenvalues();  // ascending
+  vectors = eig.eigenvectors();
+  const Eigen::Index n = values.size();
+  const double top = values.cwiseAbs().maxCoeff();
+  if (n < 2 || !(values(0) > kRigidModeThreshold * top) || values(n - 1) < 1e6 * values(0))
+    return true;
+  const Eigen::LLT<Eigen::MatrixXd> kf(kd);
+  const Eigen::LLT<Eigen::MatrixXd> mf(md);
+  if (kf.info() != Eigen::Success || mf.info() != Eigen::Success) return true;
+  // With M = L L^T: B = L^T K^-1 L has eigenvalues 1/w^2 and eigenvectors y = L^T x.
+  const Eigen::MatrixXd l = mf.matrixL();
+  Eigen::MatrixXd b = l.transpose() * kf.solve(l);
+  b = 0.5 * (b + b.transpose()).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> inv(b);
+  if (inv.info() != Eigen::Success || !(inv.eigenvalues().minCoeff() > 0.0)) return true;
+  const Eigen::MatrixXd x = mf.matrixU().solve(inv.eigenvectors());
+  const double middle = std::sqrt(values(0) * values(n - 1));
+  for (Eigen::Index i = 0; i < n && values(i) < middle; ++i) {
+    const Eigen::Index j = n - 1 - i;  // 1/w^2 ascending: the i-th smallest w^2 is last but i
+    values(i) = 1.0 / inv.eigenvalues()(j);
+    vectors.col(i) = x.col(j);
+  }
+  return true;
+}
+
+bool solve_dense(const Model& model, const SparseMatrix& k, const SparseMatrix& m, int wanted,
+                 ModalResult& result) {
+  const Eigen::MatrixXd kd(k), md(m);
+  const Eigen::Index n = kd.rows();
+  Eigen::VectorXd values(n), scales(n);
+  Eigen::MatrixXd vectors = Eigen::MatrixXd::Zero(n, n);
+  Eigen::Index next = 0;
+  // Each coupled group on its own: rigid modes are recognised against the group's own spectrum,
+  // so a stiff part does not turn the modes of an independent soft part into rigid ones.
+  for (const std::vector<int>& dofs : coupled_groups(model)) {
+    const Eigen::Index g = static_cast<Eigen::Index>(dofs.size());
+    Eigen::MatrixXd kg(g, g), mg(g, g);
+    for (Eigen::Index r = 0; r < g; ++r)
+      for (Eigen::Index c = 0; c < g; ++c) {
+        kg(r, c) = kd(dofs[r], dofs[c]);
+        mg(r, c) = md(dofs[r], dofs[c]);
+      }
+    Eigen::VectorXd gv;
+    Eigen::MatrixXd gx;
+    if (!solve_group(kg, mg, gv, gx)) {
+      result.message = "the dense eigensolver failed";
+      return false;
+    }
+    const double scale = gv.cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < g; ++i, ++next) {
+      values(next) = gv(i);
+      scales(next) = scale;
+      for (Eigen::Index r = 0; r < g; ++r) vectors(dofs[r], next) = gx(r, i);
+    }
+  }
+  classify(values, vectors, m, scales, wanted, result);
   result.solver = "dense";
   return true;
 }
@@ -93,7 +172,8 @@ bool solve_shift_invert(const SparseMatrix& k, const SparseMatrix& m, int wanted
     }
     const Eigen::VectorXd values = eigs.eigenvalues();
     ModalResult trial;
-    classify(values, eigs.eigenvectors(), m, scale, wanted, trial);
+    classify(values, eigs.eigenvectors(), m, Eigen::VectorXd::Constant(values.size(), scale),
+             wanted, trial);
     const int elastic = static_cast<int>(trial.modes.size()) - trial.rigid_modes;
     if (elastic >= wanted || nev >= n - 2) {
       result.modes = std::move(trial.modes);
@@ -125,17 +205,21 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     const SparseMatrix s = stiffness_matrix(model, data);
     const SparseMatrix k = -s;
     const SparseMatrix kt = SparseMatrix(k.transpose());
-    const double norm = k.norm();
-    result.asymmetry = norm > 0.0 ? (k - kt).norm() / norm : 0.0;
     const SparseMatrix sym = 0.5 * (k + kt);
     const SparseMatrix m = mass_matrix(model, data);
+    // Asymmetry of the mass-normalized operator (1/s^2 in every entry): a plain norm of K mixes
+    // N/m with N m, so its value would depend on the unit of length.
+    const Eigen::VectorXd d = Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse();
+    const SparseMatrix kn = d.asDiagonal() * k * d.asDiagonal();
+    const double norm = kn.norm();
+    result.asymmetry = norm > 0.0 ? (kn - SparseMatrix(kn.transpose())).norm() / norm : 0.0;
     const int wanted = std::max(1, options.modes);
     const bool dense =
         options.solver == EigenSolverKind::kDense ||
         (options.solver == EigenSolverKind::kAuto && model.n_dofs <= options.dense_limit) ||
         model.n_dofs < 2 * wanted + 24;
-    result.ok =
-        dense ? solve_dense(sym, m, wanted, result) : solve_shift_invert(sym, m, wanted, result);
+    result.ok = dense ? solve_dense(model, sym, m, wanted, result)
+                      : solve_shift_invert(sym, m, wanted, result);
     if (result.ok && result.asymmetry > 1e-6)
       result.warnings.push_back("the tangent stiffness is not symmetric (relative asymmetry " +
                                 std::to_string(result.asymmetry) +

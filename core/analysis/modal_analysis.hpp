@@ -38,12 +38,13 @@ struct ModalResult {
   std::string solver;       // "dense" or "shift-invert"
   std::vector<Mode> modes;  // ascending eigenvalue; rigid-body modes included, marked
   int rigid_modes = 0;
-  double asymmetry = 0.0;  // |K - K^T| / |K| before symmetrizing
+  double asymmetry = 0.0;  // |K - K^T| / |K| of D K D, D = diag(M)^-1/2, before symmetrizing
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
 };
 
-// Eigenvalues with |w^2| below this fraction of the largest are rigid-body (zero) modes.
+// Eigenvalues with |w^2| below this fraction of the largest are rigid-body (zero) modes. The dense
+// solver compares with the largest of each group of bodies coupled by stiffness.
 constexpr double kRigidModeThreshold = 1e-12;
 
 // Solves the eigenproblem about the configuration in data.pose. Never throws.

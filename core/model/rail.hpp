@@ -24,21 +24,44 @@ T rail_length(const Rail& rail, const T& x, bool* floored) {
   return T(x < 0.0 ? -rail.min_length : rail.min_length);
 }
 
+// The stiffness of a cantilever of length l (rail_length) at axial coordinate x. Its
+// bending-rotation couplings carry the direction sign(l) (stiffness.hpp); inside the floor that
+// sign runs linearly from -1 to 1 (x / min_length) instead of jumping at x = 0, so that forces
+// and strain energy stay continuous while the carriage passes point 1 (a jump of the energy there
+// made the energy law gain energy at every pass).
+template <class T>
+StiffnessBlocks<T> rail_stiffness(const Rail& rail, const T& x, const T& l, bool floored) {
+  StiffnessBlocks<T> k(0.0, rail.gj, rail.eiy, rail.eiz, l);
+  if (floored) {
+    const T sign = x / rail.min_length;
+    const double m2 = rail.min_length * rail.min_length;
+    k.y2 = sign * (6.0 * rail.eiy / m2);
+    k.z2 = sign * (6.0 * rail.eiz / m2);
+  }
+  return k;
+}
+
 // The rail's force law on s = (xi, phi): delta = (0, xi_y, xi_z, phi) with the stiffness of a
 // cantilever of length l = xi_x. Energy: g = dU/ds, whose first entry is the configurational force
-// dU/dl along the rail (zero while l is floored); paper: p1 = K1(l) delta, p2 = K2(l) delta.
+// dU/dl along the rail (while l is floored, only the blended sign of the couplings depends on x);
+// paper: p1 = K1(l) delta, p2 = K2(l) delta.
 template <class S>
 LocalForces<S> rail_law(const Rail& rail, const Vec6T<S>& s, bool* floored) {
   const S l = rail_length(rail, S(s(0)), floored);
-  const StiffnessBlocks<S> k(0.0, rail.gj, rail.eiy, rail.eiz, l);
+  const StiffnessBlocks<S> k = rail_stiffness(rail, S(s(0)), l, *floored);
   Vec6T<S> d = s;
   d(0) = S(0.0);
   LocalForces<S> out;
   if (rail.formulation == Formulation::kEnergy) {
     out.g = k.k2(d);
-    out.g(0) = *floored ? S(0.0)
-                        : (l < 0.0 ? S(-1.0) : S(1.0)) *
-                              strain_energy_length_derivative(rail.gj, rail.eiy, rail.eiz, l, d);
+    if (*floored) {
+      // U = ... + sign (6 / m^2) (EIy d2 d4 - EIz d1 d5) with sign = x / m.
+      const double m3 = rail.min_length * rail.min_length * rail.min_length;
+      out.g(0) = 6.0 * (rail.eiy * d(2) * d(4) - rail.eiz * d(1) * d(5)) / m3;
+    } else {
+      out.g(0) = (l < 0.0 ? S(-1.0) : S(1.0)) *
+                 strain_energy_length_derivative(rail.gj, rail.eiy, rail.eiz, l, d);
+    }
   } else {
     out.p1 = k.k1(d);
     out.p2 = k.k2(d);
@@ -62,8 +85,8 @@ T rail_wrenches(const Rail& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>
   else
     apply_paper_end_wrenches(f, law.p1, law.p2, w1, w2);
   if (rail.damping > 0.0) {
-    const StiffnessBlocks<T> k(0.0, rail.gj, rail.eiy, rail.eiz,
-                               rail_length(rail, f.xi(0), floored));
+    const StiffnessBlocks<T> k =
+        rail_stiffness(rail, f.xi(0), rail_length(rail, f.xi(0), floored), *floored);
     g += rail.damping * k.k2(deformation_rate(f, b1, b2));
   }
   apply_deformation_gradient(f, g, w1, w2);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/analysis/deformation_check.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
 
@@ -282,6 +283,9 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
   for (size_t r = 0; r < model.rails.size(); ++r)
     if (data.rail_floored[r])
       result.warnings.push_back("rail \"" + model.rails[r].name + "\" is at its min_length");
+  DeformationCheck deformation(model);
+  deformation.observe(model, data, options.time);
+  for (std::string& w : deformation.warnings(model, false)) result.warnings.push_back(std::move(w));
   result.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

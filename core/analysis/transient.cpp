@@ -6,6 +6,7 @@
 #include <exception>
 #include <limits>
 
+#include "core/analysis/deformation_check.hpp"
 #include "core/analysis/integrators.hpp"
 #include "core/analysis/sundials_support.hpp"
 #include "core/model/dynamics.hpp"
@@ -41,6 +42,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   TransientResult result;
   const auto start = std::chrono::steady_clock::now();
   const IntegratorOptions& io = options.integrator;
+  DeformationCheck deformation(model);
   try {
     SundialsContext ctx;
     OdeContext context(model, data);
@@ -63,6 +65,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
 
     const auto deliver = [&](double t) {
       const TransientSample s = sample_at(model, data, t, y.data());
+      deformation.observe(model, data, t);
       if (observer) observer(s, data);
     };
     deliver(0.0);
@@ -103,6 +106,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   for (size_t r = 0; r < model.rails.size(); ++r)
     if (data.rail_floored_ever[r])
       result.warnings.push_back("rail \"" + model.rails[r].name + "\" reached its min_length");
+  // Checked at the output samples: accepted states only, never Newton trial states.
+  for (std::string& w : deformation.warnings(model, true)) result.warnings.push_back(std::move(w));
   result.stats.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

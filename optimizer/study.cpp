@@ -25,10 +25,14 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
     if (!r.is_object()) return std::nullopt;
 
     if (const auto name = r.string("name", true)) {
+      const bool control = std::any_of(name->begin(), name->end(), [](char c) {
+        return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+      });
       if (name->empty() || name->find_first_of("/\\") != std::string::npos || *name == "." ||
-          *name == "..")
+          *name == ".." || control)
         r.error("name",
-                "must be a non-empty name without path separators (it names the output folder)");
+                "must be a non-empty name without path separators or control characters (it "
+                "names the output folder)");
       study.name = *name;
     }
     study.description = r.string("description", false).value_or("");
@@ -42,11 +46,26 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
         std::error_code ec;
         if (scene->get<std::string>().empty()) {
           r.error("scene", "expected the path of a scene file or a scene object, got \"\"");
+        } else if (scene->get<std::string>().find('\0') != std::string::npos) {
+          // The system would read the path only up to the NUL: another file.
+          r.error("scene", "the scene file path contains a NUL character");
         } else if (!std::filesystem::exists(p, ec)) {
           r.error("scene", "scene file \"" + shown + "\" not found");
+        } else if (std::filesystem::is_directory(p, ec)) {
+          r.error("scene", "scene file \"" + shown + "\" is a directory");
+        } else if (std::filesystem::equivalent(p, file, ec)) {
+          r.error("scene", "scene file \"" + shown +
+                               "\" is this study file: the scene file must hold the scene object");
         } else if (const auto j = read_json_file(p.string(), shown, diag)) {
-          model = load_scene(*j, {shown, ""}, diag);
-          study.document["scene"] = *j;
+          if (j->is_string()) {
+            // Scene files are not followed further, so references cannot loop.
+            diag.error(shown, "",
+                       "expected the scene object, got a string (a scene file cannot name "
+                       "another scene file)");
+          } else {
+            model = load_scene(*j, {shown, ""}, diag);
+            study.document["scene"] = *j;
+          }
         }
       } else {
         model = load_scene(*scene, root / "scene", diag);

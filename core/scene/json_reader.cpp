@@ -8,7 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <string>
+#include <vector>
 
 namespace beamrail {
 namespace {
@@ -376,6 +377,19 @@ class DocumentBuilder {
 
 std::optional<Json> parse_json(const std::string& text, const std::string& file,
                                Diagnostics& diag) {
+  if (text.empty()) {
+    diag.error(file, "",
+               "invalid JSON at line 1, column 1: the file is empty (expected a JSON object)");
+    return std::nullopt;
+  }
+  // The parser takes a NUL byte for the end of the input and would ignore the text after it; a
+  // raw NUL is never valid JSON.
+  if (const size_t nul = text.find('\0'); nul != std::string::npos) {
+    diag.error(file, "",
+               "invalid JSON at " + text_position(text, nul) +
+                   ": a NUL byte (JSON text cannot contain one)");
+    return std::nullopt;
+  }
   const size_t errors_before = diag.size();
   DocumentBuilder builder(text, file, diag);
   bool ok = false;
@@ -410,13 +424,32 @@ std::optional<Json> read_json_file(const std::string& path, const std::string& d
         std::string("cannot read file") + (err ? ": " + std::string(std::strerror(err)) : ""));
     return std::nullopt;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Bounded: a huge file (or a device such as /dev/zero) is refused, not read into memory.
+  const std::string limit = std::to_string(kMaxJsonFileBytes >> 20) + " MiB";
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxJsonFileBytes) {
+    diag.error(display_name, "",
+               "file too large: " + std::to_string(size) +
+                   " bytes (the limit for a study or scene file is " + limit + ")");
+    return std::nullopt;
+  }
+  std::string text;
+  std::vector<char> chunk(1 << 16);
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    text.append(chunk.data(), static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxJsonFileBytes) {
+      diag.error(display_name, "",
+                 "file too large: more than " + std::to_string(kMaxJsonFileBytes) +
+                     " bytes (the limit for a study or scene file is " + limit + ")");
+      return std::nullopt;
+    }
+  }
   if (in.bad()) {
     diag.error(display_name, "", "cannot read file: read error");
     return std::nullopt;
   }
-  return parse_json(text.str(), display_name, diag);
+  return parse_json(text, display_name, diag);
 }
 
 }  // namespace beamrail

@@ -83,7 +83,11 @@ std::optional<double> read_number(const Json& value, const Where& where, Diagnos
 // rest can be checked: callers must treat new diagnostics as failure, not just nullopt.
 std::optional<Json> parse_json(const std::string& text, const std::string& file, Diagnostics& diag);
 
-// Reads and parses a JSON file; reports unreadable files and syntax errors.
+// The largest study or scene file read [bytes]: a larger one is refused before it is parsed (the
+// parsed document takes several times the text's size in memory).
+inline constexpr size_t kMaxJsonFileBytes = size_t{16} << 20;
+
+// Reads and parses a JSON file; reports unreadable, empty and too large files and syntax errors.
 std::optional<Json> read_json_file(const std::string& path, const std::string& display_name,
                                    Diagnostics& diag);
 

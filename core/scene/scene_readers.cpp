@@ -323,6 +323,15 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
     if (segments && *segments > kMaxSegments) {
       r.error("segments", "at most " + std::to_string(kMaxSegments) + " segments");
       e.segments = 0;
+    } else if (segments && specs.n_segments + *segments > kMaxSegments) {
+      // Reported once, at the beam that crosses the limit.
+      if (specs.n_segments <= kMaxSegments)
+        r.error("segments", "at most " + std::to_string(kMaxSegments) +
+                                " segments in a scene, all beams together (the beams before "
+                                "this one have " +
+                                std::to_string(specs.n_segments) + ")");
+      specs.n_segments = kMaxSegments + 1;
+      e.segments = 0;
     } else {
       e.segments = segments.value_or(0);
     }
@@ -365,6 +374,7 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
     e.name = *name, e.body1 = *b1, e.body2 = *b2, e.p1 = *p1, e.p2 = *p2, e.p3 = *p3;
     e.material = specs.materials.at(*material);
     e.section = specs.sections.at(*section);
+    specs.n_segments += e.segments;
     specs.elements.push_back(e);
   });
 }

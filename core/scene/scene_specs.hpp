@@ -49,7 +49,7 @@ struct ElementSpec {
   SectionProperties section;
   double damping = 0.0;
   Formulation formulation = Formulation::kEnergy;
-  long segments = 0;  // at most kMaxSegments
+  long segments = 0;  // at most kMaxSegments, all elements together
   std::optional<double> min_length;
 };
 
@@ -66,12 +66,13 @@ struct SceneSpecs {
   std::vector<BodySpec> bodies;         // [0] is ground
   std::map<std::string, int> body_index;
   std::vector<ElementSpec> elements;
+  long n_segments = 0;  // of the elements read so far (kMaxSegments + 1 once over the limit)
   std::vector<Load> loads;
   std::vector<Vec3> load_points;  // global application point of each load
 };
 
-// More segments than this would only exhaust memory and time (every one adds a body and 13
-// states; 1e5 segments load in well under a second).
+// More segments than this in one scene, all beams together, would only exhaust memory and time
+// (every one adds a body and 13 states; 1e5 segments load in well under a second).
 constexpr long kMaxSegments = 100000;
 
 // Readers for each part of a scene; each reports its own problems.

@@ -45,8 +45,9 @@ void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>
     if (!specs.bodies[e.body2].fixed) extra[e.body2].push_back(lumped(mh, e.p2, frame, half));
 
     // Interior bodies share the element's orientation; their velocities blend the ends'.
-    const BodySpec& b1 = specs.bodies[e.body1];
-    const BodySpec& b2 = specs.bodies[e.body2];
+    // Copies: adding the interior bodies below may reallocate specs.bodies.
+    const BodySpec b1 = specs.bodies[e.body1];
+    const BodySpec b2 = specs.bodies[e.body2];
     const Mat3 a1 = rotation_matrix<double>(b1.orientation), a2 = rotation_matrix<double>(b2.orientation);
     const Vec3 om1 = a1 * b1.angular_velocity, om2 = a2 * b2.angular_velocity;
     int previous = e.body1;

@@ -49,10 +49,17 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
         } else if (scene->get<std::string>().find('\0') != std::string::npos) {
           // The system would read the path only up to the NUL: another file.
           r.error("scene", "the scene file path contains a NUL character");
-        } else if (!std::filesystem::exists(p, ec)) {
-          r.error("scene", "scene file \"" + shown + "\" not found");
-        } else if (std::filesystem::is_directory(p, ec)) {
+        } else if (const auto status = std::filesystem::status(p, ec); ec || !exists(status)) {
+          // ec also tells of a loop of links or a folder that cannot be searched.
+          r.error("scene", "scene file \"" + shown + "\" " +
+                               (ec && ec != std::errc::no_such_file_or_directory
+                                    ? "cannot be opened: " + ec.message()
+                                    : std::string("not found")));
+        } else if (is_directory(status)) {
           r.error("scene", "scene file \"" + shown + "\" is a directory");
+        } else if (!is_regular_file(status)) {
+          // A pipe would block the check until something writes to it; a device may never end.
+          r.error("scene", "scene file \"" + shown + "\" is not a regular file");
         } else if (std::filesystem::equivalent(p, file, ec)) {
           r.error("scene", "scene file \"" + shown +
                                "\" is this study file: the scene file must hold the scene object");

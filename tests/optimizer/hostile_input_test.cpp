@@ -5,6 +5,7 @@
 // (missing files, bad values, syntax errors) are in bad_input_test.cpp.
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -123,19 +124,40 @@ TEST_F(HostileInput, ScenePathToADirectory) {
                         "bad.json:/scene: ", "scene file \".\" is a directory"));
 }
 
-TEST_F(HostileInput, ScenePathToADevice) {
-  // Endless: refused at the size limit after reading it, not read until memory runs out.
+TEST_F(HostileInput, ScenePathToADeviceOrAPipe) {
+  // A device may never end and a pipe blocks until something writes to it: neither is opened.
+  EXPECT_TRUE(OnlyError(check(study_text(quoted("/dev/zero"))),
+                        "bad.json:/scene: ", "scene file \"/dev/zero\" is not a regular file"));
+  EXPECT_TRUE(OnlyError(check(study_text(quoted("/dev/null"))),
+                        "bad.json:/scene: ", "scene file \"/dev/null\" is not a regular file"));
+  ASSERT_EQ(mkfifo((dir_ / "pipe.json").c_str(), 0600), 0);
+  EXPECT_TRUE(OnlyError(check(study_text(quoted("pipe.json"))),
+                        "bad.json:/scene: ", "scene file \"pipe.json\" is not a regular file"));
+}
+
+TEST_F(HostileInput, StudyFileFromADevice) {
+  // The study itself may come through a pipe (`beamrail check <(...)`), so it is read, but only
+  // up to the size limit: an endless device ends in bounded time and memory.
   const auto start = std::chrono::steady_clock::now();
-  EXPECT_TRUE(OnlyError(check(study_text(quoted("/dev/zero"))), "/dev/zero: ",
+  EXPECT_TRUE(OnlyError(run({"check", "/dev/zero"}), "/dev/zero: ",
                         "file too large: more than 16777216 bytes (the limit for a study or scene "
                         "file is 16 MiB)"));
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
   EXPECT_TRUE(
-      OnlyError(check(study_text(quoted("/dev/null"))), "/dev/null: ",
+      OnlyError(run({"check", "/dev/null"}), "/dev/null: ",
                 "invalid JSON at line 1, column 1: the file is empty (expected a JSON object)"));
-  // The same for the study file itself.
-  EXPECT_TRUE(OnlyError(run({"check", "/dev/zero"}), "/dev/zero: ", "file too large"));
-  EXPECT_TRUE(OnlyError(run({"check", "/dev/null"}), "/dev/null: ", "the file is empty"));
+}
+
+TEST_F(HostileInput, ScenePathThroughALoopOfLinks) {
+  fs::create_symlink("loop.json", dir_ / "loop.json");
+  EXPECT_TRUE(OnlyError(check(study_text(quoted("loop.json"))), "bad.json:/scene: ",
+                        "scene file \"loop.json\" cannot be opened: Too many levels of symbolic "
+                        "links"));
+  // A path through a file.
+  write("parts/scene.json", kScene);
+  EXPECT_TRUE(
+      OnlyError(check(study_text(quoted("parts/scene.json/scene.json"))), "bad.json:/scene: ",
+                "scene file \"parts/scene.json/scene.json\" cannot be opened: Not a directory"));
 }
 
 TEST_F(HostileInput, UnreadableSceneFile) {

@@ -1,6 +1,9 @@
 #include "core/scene/scene_loader.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
+#include <set>
+#include <string>
 
 #include "core/model/rotation.hpp"
 #include "core/scene/scene_specs.hpp"
@@ -106,6 +109,31 @@ Vec3 combine_masses(const BodySpec& b, const std::vector<PointMass>& extra, doub
   return c;
 }
 
+// The first quantity of a body that is not finite ("mass", ...).
+std::string out_of_range(const Body& b) {
+  if (!std::isfinite(b.mass)) return "mass";
+  if (!b.position.allFinite()) return "centre of mass";
+  if (!b.inertia.allFinite()) return "inertia";
+  return "initial velocity";
+}
+
+// The first quantity of an element that is not finite, or "".
+std::string out_of_range(const ElementSpec& e, const ElementEnds& ends) {
+  const SectionProperties& s = e.section;
+  const double modulus_e = e.material.e, modulus_g = e.material.g;
+  if (!std::isfinite(ends.length) || !ends.r1.allFinite() || !ends.r2.allFinite() ||
+      !ends.frame1.allFinite() || !ends.frame2.allFinite())
+    return "the geometry (length or attachment points)";
+  if (!std::isfinite(s.area) || !std::isfinite(s.torsion_constant) || !std::isfinite(s.iy) ||
+      !std::isfinite(s.iz) || !std::isfinite(s.wy) || !std::isfinite(s.wz))
+    return "the section";
+  if (!std::isfinite(modulus_e * s.area)) return "the axial stiffness E S";
+  if (!std::isfinite(modulus_g * s.torsion_constant)) return "the torsional stiffness G Ix";
+  if (!std::isfinite(modulus_e * s.iy) || !std::isfinite(modulus_e * s.iz))
+    return "the bending stiffness E I";
+  return "";
+}
+
 ElementEnds make_ends(const ElementSpec& e, const std::vector<Body>& bodies) {
   ElementEnds ends;
   ends.body1 = e.body1;
@@ -147,6 +175,15 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
 
   Model model;
   model.gravity = specs.gravity;
+  // One report per scene entry: the interior bodies of a segmented beam share their beam's.
+  std::set<std::string> reported;
+  auto body_error = [&](const BodySpec& s, const std::string& what) {
+    if (!reported.insert(s.where.pointer).second) return;
+    const std::string who = s.generated
+                                ? "beam \"" + s.name.substr(0, s.name.rfind(".node")) + "\": "
+                                : "body \"" + s.name + "\": ";
+    diag.error(s.where.file, s.where.pointer, who + what);
+  };
   for (size_t i = 0; i < specs.bodies.size(); ++i) {
     const BodySpec& s = specs.bodies[i];
     Body b;
@@ -158,23 +195,51 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     b.velocity = s.velocity;
     b.angular_velocity = s.angular_velocity;
     b.position = combine_masses(s, extra[i], &b.mass, &b.inertia);
+    // Values each finite can still combine into an overflow (a density of 1e308, a centre 1e308
+    // away): reported here rather than met as NaN in an analysis.
+    if (!std::isfinite(b.mass) || !b.inertia.allFinite() || !b.position.allFinite() ||
+        !b.velocity.allFinite() || !b.angular_velocity.allFinite()) {
+      body_error(s, "the " + out_of_range(b) + (s.generated ? " of its interior bodies" : "") +
+                        " is out of the range of double precision (not finite)");
+      continue;
+    }
     if (!b.fixed) {
       const Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia);
       if (!(b.mass > 0.0) || !(eig.eigenvalues().minCoeff() > 0.0)) {
-        diag.error(s.where.file, s.where.pointer,
-                   "free body \"" + s.name +
-                       "\" has no mass: give \"mass\" and \"inertia\", attach a segmented beam, or "
-                       "set \"fixed\": true");
+        if (s.generated)
+          body_error(s,
+                     "the mass or inertia of its interior bodies is zero in double precision "
+                     "(density or section too small)");
+        else
+          diag.error(s.where.file, s.where.pointer,
+                     "free body \"" + s.name +
+                         "\" has no mass: give \"mass\" and \"inertia\", attach a segmented "
+                         "beam, or set \"fixed\": true");
         continue;
       }
       b.inertia_inverse = b.inertia.inverse();
+      if (!b.inertia_inverse.allFinite()) {
+        body_error(s, std::string("the inertia") + (s.generated ? " of its interior bodies" : "") +
+                          " cannot be inverted in double precision (values too large or too "
+                          "small)");
+        continue;
+      }
     }
     model.bodies.push_back(b);
   }
   if (diag.size() > errors_before) return std::nullopt;
 
+  reported.clear();  // now one report per scene element, not per segment
   for (const ElementSpec& e : elements) {
     const ElementEnds ends = make_ends(e, model.bodies);
+    if (const std::string what = out_of_range(e, ends); !what.empty()) {
+      const std::string name = e.segments < 0 ? e.name.substr(0, e.name.rfind(".seg")) : e.name;
+      if (reported.insert(e.where.pointer).second)
+        diag.error(e.where.file, e.where.pointer,
+                   std::string(e.rail ? "rail" : "beam") + " \"" + name + "\": " + what +
+                       " is out of the range of double precision (not finite)");
+      continue;
+    }
     const double modulus_e = e.material.e, modulus_g = e.material.g;
     if (!e.rail) {
       Beam b;
@@ -208,12 +273,22 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     }
   }
 
+  if (diag.size() > errors_before) return std::nullopt;
+
   for (size_t k = 0; k < specs.loads.size(); ++k) {
     Load load = specs.loads[k];
     const Body& b = model.bodies[load.body];
     load.offset = rotation_matrix<double>(b.orientation).transpose() * (specs.load_points[k] - b.position);
+    // Every load was accepted, so k is its index in the scene.
+    if (!load.offset.allFinite()) {
+      diag.error(where.file, (where / "loads" / k / "point").pointer,
+                 "the distance from the body's centre of mass is out of the range of double "
+                 "precision (not finite)");
+      continue;
+    }
     model.loads.push_back(load);
   }
+  if (diag.size() > errors_before) return std::nullopt;
 
   model.finalize();
   if (model.n_free() == 0) {

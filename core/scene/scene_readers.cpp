@@ -209,6 +209,18 @@ void read_sections(ObjectReader& scene, SceneSpecs& specs) {
     ObjectReader r(v, at, scene.diagnostics());
     std::optional<SectionProperties> s;
     if (r.is_object()) s = read_section(r);
+    // Dimensions each finite can give properties that are not (a width of 1e200: S = inf, or
+    // 1e-200: S = 0).
+    const auto in_range = [](double x) { return std::isfinite(x) && x > 0.0; };
+    if (s && !(in_range(s->area) && in_range(s->torsion_constant) && in_range(s->iy) &&
+               in_range(s->iz))) {
+      scene.diagnostics().error(
+          at.file, at.pointer,
+          "the section's properties are out of the range of double precision (S = " +
+              number_text(s->area) + ", Ix = " + number_text(s->torsion_constant) +
+              ", Iy = " + number_text(s->iy) + ", Iz = " + number_text(s->iz) + ")");
+      s.reset();
+    }
     if (s)
       specs.sections[name] = *s;
     else
@@ -277,8 +289,15 @@ void read_bodies(ObjectReader& scene, SceneSpecs& specs) {
 std::optional<Mat3> element_frame(const Vec3& p1, const Vec3& p2, const Vec3& p3,
                                   const Where& where, Diagnostics& diag) {
   const Vec3 d = p2 - p1;
+  // Beyond ~1e154 m squares overflow: the points would otherwise be taken to coincide.
+  if (!std::isfinite(d.squaredNorm()) || !std::isfinite((p3 - p1).squaredNorm())) {
+    diag.error(where.file, where.pointer,
+               "the points are too far apart for double precision (their squared distances "
+               "overflow)");
+    return std::nullopt;
+  }
   const double length = d.norm();
-  const double scale = std::max({p1.norm(), p2.norm(), p3.norm()});
+  const double scale = std::max({p1.stableNorm(), p2.stableNorm(), p3.stableNorm()});
   if (!(length > 1e-12 * scale) || length == 0.0) {
     diag.error(where.file, (where / "point2").pointer, "point1 and point2 coincide");
     return std::nullopt;

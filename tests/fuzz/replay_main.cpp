@@ -1,7 +1,8 @@
 // A short fuzz run with any compiler: feeds LLVMFuzzerTestOneInput (study_fuzz.cpp) every file of
-// a corpus, then random mutations of them (byte edits, dictionary tokens, splices) from a fixed
-// seed, for a bounded number of runs and time. A crash, an abort from a broken contract or an input
-// that runs longer than --input-seconds saves the input that caused it and fails.
+// a corpus, then random mutations of them (structural changes as in json_mutator.hpp, byte edits,
+// dictionary tokens, splices) from a fixed seed, for a bounded number of runs and time. A crash,
+// an abort from a broken contract or an input that runs longer than --input-seconds saves the
+// input that caused it and fails.
 //
 //   study_fuzz_replay [--runs N] [--seconds S] [--seed K] [--input-seconds T] [--dict FILE]
 //                     [--crash FILE] CORPUS_DIR_OR_FILE...
@@ -21,6 +22,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "tests/fuzz/json_mutator.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
@@ -95,24 +98,14 @@ std::vector<Bytes> read_dictionary(const fs::path& p) {
   return out;
 }
 
-// xorshift64*: the same sequence with every compiler and library.
-class Random {
- public:
-  explicit Random(uint64_t seed) : s_(seed ? seed : 1) {}
-  uint64_t next() {
-    s_ ^= s_ >> 12, s_ ^= s_ << 25, s_ ^= s_ >> 27;
-    return s_ * 2685821657736338717ull;
-  }
-  size_t below(size_t n) { return n ? static_cast<size_t>(next() % n) : 0; }
-
- private:
-  uint64_t s_;
-};
+using beamrail::fuzz::Random;
 
 // One random edit of the kinds libFuzzer makes.
 void mutate(Bytes& b, const std::vector<Bytes>& corpus, const std::vector<Bytes>& dict,
             Random& rng) {
   static const char kInteresting[] = "{}[]\",:0-1e.9\\\x00\xff\xc3 ";
+  // Half the time a structural change of a document that still parses.
+  if (rng.below(2) == 0 && beamrail::fuzz::mutate_json(b, rng)) return;
   const size_t at = rng.below(b.size() + 1);
   switch (rng.below(8)) {
     case 0:  // flip a bit

@@ -5,12 +5,17 @@
 //   - a study is returned exactly when no problem was reported;
 //   - every problem is one line "file:/json/pointer: message" naming the file it was found in,
 //     with no control character;
+//   - every number of a loaded model is finite (a huge value caught at the boundary, not as NaN
+//     results or a misleading message later);
 //   - the document of a loaded study (scene file inlined) loads again, as design studies do.
+// In the libFuzzer build, half of the mutations are structural (json_mutator.hpp).
 // Relative scene paths resolve in a scratch folder where "scenes/" holds the example scene files
 // of studies/scenes, so that the seed studies that name one load as they do from studies/.
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -21,6 +26,7 @@
 
 #include "core/scene/diagnostics.hpp"
 #include "optimizer/study.hpp"
+#include "tests/fuzz/json_mutator.hpp"
 
 #ifndef BEAMRAIL_FUZZ_SCENES_DIR
 #error "BEAMRAIL_FUZZ_SCENES_DIR must name studies/scenes"
@@ -77,7 +83,60 @@ void check_report(const beamrail::Diagnostics& diag, const std::string& study_fi
   if (lines != diag.size()) contract_broken("a problem spans more than one line", text);
 }
 
+template <class M>
+bool finite(const M& m) {
+  return m.allFinite();
+}
+bool finite(double x) { return std::isfinite(x); }
+
+bool finite(const beamrail::SectionProperties& s) {
+  return finite(s.area) && finite(s.torsion_constant) && finite(s.iy) && finite(s.iz) &&
+         finite(s.wy) && finite(s.wz);
+}
+
+bool finite(const beamrail::ElementEnds& e) {
+  return finite(e.r1) && finite(e.r2) && finite(e.frame1) && finite(e.frame2) && finite(e.length);
+}
+
+// The name of the first part of the model holding a number that is not finite, or "".
+std::string first_non_finite(const beamrail::Model& m) {
+  if (!finite(m.gravity)) return "gravity";
+  for (const beamrail::Body& b : m.bodies)
+    if (!finite(b.mass) || !finite(b.inertia) || !finite(b.inertia_inverse) ||
+        !finite(b.position) || !finite(b.orientation) || !finite(b.velocity) ||
+        !finite(b.angular_velocity) || !finite(b.declared_mass))
+      return "body " + b.name;
+  for (const beamrail::Beam& e : m.beams)
+    if (!finite(e.ends) || !finite(e.ea) || !finite(e.gj) || !finite(e.eiy) || !finite(e.eiz) ||
+        !finite(e.damping) || !finite(e.section) || !finite(e.density))
+      return "beam " + e.name;
+  for (const beamrail::Rail& e : m.rails)
+    if (!finite(e.ends) || !finite(e.gj) || !finite(e.eiy) || !finite(e.eiz) ||
+        !finite(e.min_length) || !finite(e.damping) || !finite(e.section) || !finite(e.density))
+      return "rail " + e.name;
+  for (size_t k = 0; k < m.loads.size(); ++k)
+    if (!finite(m.loads[k].offset) || !finite(m.loads[k].value)) return "load " + std::to_string(k);
+  return "";
+}
+
 }  // namespace
+
+#ifdef BEAMRAIL_LIBFUZZER
+extern "C" size_t LLVMFuzzerMutate(uint8_t* data, size_t size, size_t max_size);
+
+extern "C" size_t LLVMFuzzerCustomMutator(uint8_t* data, size_t size, size_t max_size,
+                                          unsigned int seed) {
+  beamrail::fuzz::Random rng(seed);
+  if (rng.below(2) == 0) {
+    std::string text(reinterpret_cast<const char*>(data), size);
+    if (beamrail::fuzz::mutate_json(text, rng) && text.size() <= max_size) {
+      std::copy(text.begin(), text.end(), data);
+      return text.size();
+    }
+  }
+  return LLVMFuzzerMutate(data, size, max_size);
+}
+#endif
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const fs::path file = scratch() / "study.json";
@@ -98,6 +157,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   // What `beamrail check` prints needs a built model.
   if (study->model.bodies.empty()) contract_broken("a loaded study has no ground body", "");
+  if (const std::string part = first_non_finite(study->model); !part.empty())
+    contract_broken("a loaded model holds a number that is not finite", part);
 
   // Design studies rebuild each design from the document with the scene inlined.
   beamrail::Diagnostics again;

@@ -160,6 +160,15 @@ TEST_F(HostileInput, ScenePathThroughALoopOfLinks) {
                 "scene file \"parts/scene.json/scene.json\" cannot be opened: Not a directory"));
 }
 
+TEST_F(HostileInput, SceneFileWhoseReadingFails) {
+  // A regular file whose reading fails for any user: this process's memory from address 0.
+  if (!fs::exists("/proc/self/mem")) GTEST_SKIP() << "no /proc/self/mem";
+  EXPECT_TRUE(OnlyError(check(study_text(quoted("/proc/self/mem"))),
+                        "/proc/self/mem: ", "cannot read file: read error"));
+  EXPECT_TRUE(OnlyError(run({"check", "/proc/self/mem"}),
+                        "/proc/self/mem: ", "cannot read file: read error"));
+}
+
 TEST_F(HostileInput, UnreadableSceneFile) {
   write("parts/locked.json", kScene);
   fs::permissions(dir_ / "parts/locked.json", fs::perms::none);

@@ -39,6 +39,7 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x) const {
     } else {
       EvaluationOptions options;
       options.max_seconds = study_.design->max_seconds_per_design;
+      options.structure_cache = structures_.get();
       const Evaluation ev = beamrail::evaluate(*design, design->model, options);
       out.status = ev.status;
       out.message = ev.message;

@@ -1,11 +1,13 @@
 // Evaluating designs: the study with its design variables set to given values is rebuilt,
-// re-validated and run. Each call builds its own Model and Data, so designs evaluate in parallel
-// without locks.
+// re-validated and run. Each call builds its own Model and Data, so designs evaluate in parallel;
+// designs of one topology share the sparse Jacobian structure and its KLU ordering.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "core/analysis/sparse_structure.hpp"
 #include "optimizer/study.hpp"
 
 namespace beamrail {
@@ -29,12 +31,15 @@ class DesignEvaluator {
   Json document(const std::vector<double>& x) const;
 
   const Study& study() const { return study_; }
+  // The structures analysed for, and reused by, the evaluations so far.
+  const SparseStructureCache& structures() const { return *structures_; }
   size_t n_variables() const { return study_.design->variables.size(); }
 
  private:
   const Study& study_;
   Json base_;                                              // study.document without "study"
   std::vector<std::vector<Json::json_pointer>> pointers_;  // per variable
+  std::shared_ptr<SparseStructureCache> structures_ = std::make_shared<SparseStructureCache>();
 };
 
 }  // namespace beamrail

@@ -172,7 +172,8 @@ class Runner {
   }
 
   // The run's options with max_seconds cut to what is left of the evaluation's budget.
-  TransientOptions budgeted(TransientOptions options) const {
+  TransientOptions budgeted(TransientOptions options) {
+    options.structure_cache = options_.structure_cache ? options_.structure_cache : &structures_;
     if (options_.max_seconds > 0.0) {
       const double used =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -183,7 +184,7 @@ class Runner {
   }
 
   // Reruns the transient at rtol and atol divided by ten and measures how far the run was from it.
-  Verification verify(const TransientOptions& options, const Trajectory& run) const {
+  Verification verify(const TransientOptions& options, const Trajectory& run) {
     Verification v;
     TransientOptions tight = budgeted(options);
     tight.integrator.rtol /= 10.0;
@@ -216,6 +217,7 @@ class Runner {
   Data static_data_;
   StaticOptions static_options_;
   std::optional<StaticResult> static_result_;
+  SparseStructureCache structures_;  // when the caller shares none
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -19,8 +19,8 @@ struct Verification {
   bool ok = false;
   std::string message;
   double rtol = 0.0, atol = 0.0;  // of the tighter run
-  double error = 0.0;  // largest body-centre distance between the runs / largest motion
-  SolverStats stats;   // of the tighter run
+  double error = 0.0;             // largest body-centre distance between the runs / largest motion
+  SolverStats stats;              // of the tighter run
 };
 
 struct AnalysisReport {
@@ -31,8 +31,8 @@ struct AnalysisReport {
   double wall_seconds = 0.0;
   // transient
   SolverStats stats;
-  std::string integrator;     // method, and table if any
-  std::string linear_solver;  // dense | sparse | none
+  std::string integrator;                   // method, and table if any
+  std::string linear_solver;                // dense | sparse | none
   double t_reached = 0.0;                   // [s]
   double energy_initial = 0.0;              // total energy at t = 0 [J]
   double energy_final = 0.0;                // at the last sample [J]
@@ -61,6 +61,9 @@ struct EvaluationOptions {
   // Wall-clock budget of the whole evaluation [s]; 0: none. A transient still running when it is
   // spent stops, and the evaluation's status is "timeout".
   double max_seconds = 0.0;
+  // Sparse Jacobian structures shared with other evaluations of the same topology (thread-safe);
+  // nullptr: the evaluation's runs share one among themselves only.
+  SparseStructureCache* structure_cache = nullptr;
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed

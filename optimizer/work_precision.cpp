@@ -35,6 +35,8 @@ int run_work_precision(const Study& study, const RunSettings& settings) {
       study.analyses[find_analysis(study, AnalysisSpec::Type::kTransient)];
   TransientOptions base = analysis.transient;
   base.max_seconds = 0.0;
+  SparseStructureCache structures;  // every run integrates the same model
+  base.structure_cache = &structures;
 
   TransientOptions reference_options = base;
   reference_options.integrator = plan.reference;

@@ -6,11 +6,13 @@
 #include <cvode/cvode_ls.h>
 #include <cvode/cvode_proj.h>
 #include <sunlinsol/sunlinsol_dense.h>
-#include <sunlinsol/sunlinsol_klu.h>
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
+#include <memory>
+
+#include "core/analysis/klu_solver.hpp"
 
 namespace beamrail {
 namespace {
@@ -63,9 +65,11 @@ struct LinearAlgebra {
       return false;
     }
     if (sparse) {
-      c.pattern = make_jacobian_pattern(c.model);
-      matrix.m = SUNSparseMatrix(n, n, std::max(1L, c.pattern.nnz()), CSC_MAT, ctx);
-      solver.s = SUNLinSol_KLU(y, matrix.m, ctx);
+      // The topology's pattern and ordering, analysed once and shared through the cache.
+      c.structure = c.structure_cache ? c.structure_cache->get(c.model)
+                                      : std::make_shared<const SparseStructure>(c.model);
+      matrix.m = SUNSparseMatrix(n, n, std::max(1L, c.structure->pattern().nnz()), CSC_MAT, ctx);
+      solver.s = make_klu_solver(c.structure, ctx);
     } else {
       matrix.m = SUNDenseMatrix(n, n, ctx);
       solver.s = SUNLinSol_Dense(y, matrix.m, ctx);
@@ -101,7 +105,7 @@ class Cvode : public Integrator {
       return fail(error, "CVODE linear solver: " + messages_.last);
     algebra_.jacobian(o, [&](CVLsJacFn f) { CVodeSetJacFn(mem_, f); });
     linear_solver = algebra_.sparse ? "sparse" : "dense";
-    nnz = static_cast<int>(c.pattern.nnz());
+    nnz = c.structure ? c.structure->pattern().nnz() : 0;
     // |q| = 1 by projection (CVODE projects for BDF only; Adams states are renormalized when
     // the analysis restarts and the rotation uses q/|q| throughout).
     if (o.method == "bdf") CVodeSetProjFn(mem_, ode_project);
@@ -167,7 +171,7 @@ class ArkodeImplicit : public Integrator {
       return fail(error, "ARKODE linear solver: " + messages_.last);
     algebra_.jacobian(o, [&](ARKLsJacFn f) { ARKStepSetJacFn(mem_, f); });
     linear_solver = algebra_.sparse ? "sparse" : "dense";
-    nnz = static_cast<int>(c.pattern.nnz());
+    nnz = c.structure ? c.structure->pattern().nnz() : 0;
     ARKStepSetPostprocessStepFn(mem_, ode_normalize);
     // Measured on the reference cantilever (N = 10, rtol 3e-6): deducing the stage derivative from
     // the Newton solution and the variable-order predictor cut right-hand sides from 99k to 53k.

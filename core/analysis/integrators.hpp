@@ -25,7 +25,7 @@ class Integrator {
   virtual std::string failure(int flag) const = 0;
   // "dense", "sparse" or "none" (explicit methods).
   std::string linear_solver = "none";
-  int nnz = 0;  // stored Jacobian entries (sparse)
+  long nnz = 0;  // stored Jacobian entries (sparse)
 };
 
 // Builds the integrator of options.method for the system in `context`, starting at (0, y0).

@@ -12,17 +12,6 @@ namespace {
 
 constexpr int kS = kStatesPerBody;
 
-// Whether entry (r, s) of a 13 x 13 block can be non-zero.
-bool structural(bool diagonal, int r, int s) {
-  if (r >= 7) return true;  // accelerations depend on every coupled state
-  if (!diagonal) return false;
-  // dc/dt = v; the (zero) diagonal is stored too, so that SUNDIALS forms I - gamma J in place
-  // (without it, SUNMatScaleAddI_Sparse rebuilds the matrix at every setup: 92 % of the run time
-  // of a 1,000-body chain).
-  if (r < 3) return s == r + 7 || s == r;
-  return (s >= 3 && s <= 6) || s >= 10;  // dq/dt = q (x) (0, w) / 2
-}
-
 template <class F>
 int guarded(OdeContext* c, F&& f) {
   try {
@@ -36,35 +25,6 @@ int guarded(OdeContext* c, F&& f) {
 }
 
 }  // namespace
-
-JacobianPattern make_jacobian_pattern(const Model& model) {
-  const long n = model.n_states;
-  const auto& blocks = model.pattern.blocks;
-  // Blocks by column body.
-  std::vector<std::vector<int>> by_column(model.n_free());
-  for (size_t b = 0; b < blocks.size(); ++b)
-    by_column[blocks[b].col].push_back(static_cast<int>(b));
-  for (auto& list : by_column)
-    std::sort(list.begin(), list.end(),
-              [&](int a, int b) { return blocks[a].row < blocks[b].row; });
-  JacobianPattern p;
-  p.positions.assign(blocks.size() * kS * kS, -1);
-  p.column_starts.assign(n + 1, 0);
-  for (long j = 0; j < n; ++j) {
-    const int body = static_cast<int>(j / kS), s = static_cast<int>(j % kS);
-    for (int b : by_column[body]) {
-      const bool diagonal = blocks[b].row == blocks[b].col;
-      for (int r = 0; r < kS; ++r) {
-        if (!structural(diagonal, r, s)) continue;
-        p.positions[static_cast<size_t>(b) * kS * kS + kS * r + s] =
-            static_cast<long>(p.rows.size());
-        p.rows.push_back(static_cast<long>(kS) * blocks[b].row + r);
-      }
-    }
-    p.column_starts[j + 1] = static_cast<long>(p.rows.size());
-  }
-  return p;
-}
 
 int ode_rhs(double t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* c = static_cast<OdeContext*>(user_data);
@@ -100,7 +60,7 @@ int ode_sparse_jacobian(double t, N_Vector y, N_Vector, SUNMatrix jac, void* use
   auto* c = static_cast<OdeContext*>(user_data);
   return guarded(c, [&] {
     state_jacobian_blocks(c->model, c->data, t, N_VGetArrayPointer(y), c->blocks);
-    const JacobianPattern& p = c->pattern;
+    const JacobianPattern& p = c->structure->pattern();
     sunindextype* starts = SUNSparseMatrix_IndexPointers(jac);
     sunindextype* rows = SUNSparseMatrix_IndexValues(jac);
     double* values = SUNSparseMatrix_Data(jac);

@@ -1,5 +1,5 @@
 // The equations of motion as SUNDIALS sees them: right-hand side, exact Jacobian (dense or sparse
-// CSC with a structure computed once per model), and the quaternion projection. Callbacks never
+// CSC with the structure of the model's topology), and the quaternion projection. Callbacks never
 // throw: an exception is recorded in the context and reported as an unrecoverable failure.
 #pragma once
 
@@ -7,36 +7,25 @@
 #include <sundials/sundials_matrix.h>
 
 #include <chrono>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "core/analysis/sparse_structure.hpp"
 #include "core/model/data.hpp"
 #include "core/model/dynamics.hpp"
 #include "core/model/model.hpp"
 
 namespace beamrail {
 
-// Structure of the sparse state Jacobian: per pattern block of 13 x 13, the entries that can be
-// non-zero (dc/dt = v, dq/dt depends on q and w only, accelerations on everything coupled), in
-// compressed sparse columns with sorted row indices.
-struct JacobianPattern {
-  std::vector<long> column_starts;  // n_states + 1
-  std::vector<long> rows;           // nnz
-  // Position in the value array of entry (r, s) of pattern block b: positions[b * 169 + 13 r + s],
-  // -1 when the entry is structurally zero.
-  std::vector<long> positions;
-  long nnz() const { return static_cast<long>(rows.size()); }
-};
-
-JacobianPattern make_jacobian_pattern(const Model& model);
-
 struct OdeContext {
   OdeContext(const Model& m, Data& d) : model(m), data(d) {}
   const Model& model;
   Data& data;
   std::vector<Mat13> blocks;
-  JacobianPattern pattern;     // filled when the sparse solver is used
-  std::string callback_error;  // an exception caught inside a callback
+  SparseStructureCache* structure_cache = nullptr;   // where the sparse solver gets its structure
+  std::shared_ptr<const SparseStructure> structure;  // set when the sparse solver is used
+  std::string callback_error;                        // an exception caught inside a callback
   // Wall-clock budget: past this moment the right-hand side fails unrecoverably.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
   bool timed_out = false;

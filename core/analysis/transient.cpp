@@ -46,6 +46,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   try {
     SundialsContext ctx;
     OdeContext context(model, data);
+    context.structure_cache = options.structure_cache;
     if (options.max_seconds > 0.0)
       context.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                      std::chrono::duration<double>(options.max_seconds));

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/analysis/sparse_structure.hpp"
 #include "core/model/data.hpp"
 #include "core/model/model.hpp"
 
@@ -43,6 +44,9 @@ struct TransientOptions {
   double output_step = 0.01;  // [s]
   IntegratorOptions integrator;
   double max_seconds = 0.0;   // wall-clock budget; 0: none. Exceeding it ends the run as a timeout
+  // Shares the sparse Jacobian structure and KLU ordering between runs of one topology (designs,
+  // reruns); nullptr: this run analyses its own.
+  SparseStructureCache* structure_cache = nullptr;
 };
 
 // Energies at one output time [J].

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/analysis/ode_system.hpp"
+#include "core/analysis/sparse_structure.hpp"
 #include "core/model/dynamics.hpp"
 #include "tests/benchmarks/reference_problem.hpp"
 
@@ -32,8 +33,8 @@ void RightHandSide(benchmark::State& state) {
   }
   state.counters["bodies"] = c.model.n_free();
   state.counters["ns_per_body"] = benchmark::Counter(
-      static_cast<double>(c.model.n_free()), benchmark::Counter::kIsIterationInvariantRate |
-                                                 benchmark::Counter::kInvert);
+      static_cast<double>(c.model.n_free()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(RightHandSide)->Arg(10)->Arg(100)->Arg(1000)->Arg(10000);
 
@@ -54,6 +55,37 @@ void SparsePatternBuild(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(make_jacobian_pattern(c.model));
 }
 BENCHMARK(SparsePatternBuild)->Arg(10)->Arg(10000);
+
+// What a design of an already seen topology saves: the pattern and KLU's symbolic analysis
+// (SparseStructure) against a lookup in the cache (comparing the topology).
+void SparseStructureAnalysis(benchmark::State& state) {
+  Chain c(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    SparseStructure s(c.model);
+    benchmark::DoNotOptimize(s.symbolic());
+  }
+  state.counters["bodies"] = c.model.n_free();
+}
+BENCHMARK(SparseStructureAnalysis)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Unit(benchmark::kMicrosecond);
+
+void SparseStructureCacheHit(benchmark::State& state) {
+  Chain c(static_cast<int>(state.range(0)));
+  SparseStructureCache cache;
+  cache.get(c.model);
+  for (auto _ : state) benchmark::DoNotOptimize(cache.get(c.model));
+  state.counters["bodies"] = c.model.n_free();
+}
+BENCHMARK(SparseStructureCacheHit)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace beamrail

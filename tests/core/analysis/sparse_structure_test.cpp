@@ -1,0 +1,200 @@
+// The sparse structure of a topology and the KLU solver that factors with it: the solver solves
+// the Newton systems it is given (fresh factorization, refactorization with the old pivots, new
+// pivots when the old ones went bad, a singular matrix as a recoverable failure); the cache hands
+// one structure to every model of a topology and a new one to each other topology; a run with a
+// shared structure is the run without one, bit for bit.
+#include "core/analysis/sparse_structure.hpp"
+
+#include <gtest/gtest.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "core/analysis/klu_solver.hpp"
+#include "core/analysis/sundials_support.hpp"
+#include "tests/support/transient_run.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::scene_from_json;
+
+// A 1 m steel cantilever in `segments` segments of a square section `width` wide, `length` long.
+std::string cantilever(int segments, double width = 0.01, double length = 1.0) {
+  const std::string w = std::to_string(width), l = std::to_string(length);
+  return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq": {"shape": "rectangle", "width": )" +
+         w + R"(, "height": )" + w + R"(}},
+    "bodies": [{"name": "tip", "position": [)" +
+         l + R"(, 0, 0]}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [)" +
+         l + R"(, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq",
+               "segments": )" +
+         std::to_string(segments) + R"(}],
+    "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0],
+               "time": {"type": "step", "at": 0.0}}]})";
+}
+
+// Bodies b1 and b2, b1 held by ground and b2 by `holder`.
+std::string two_bodies(const std::string& holder) {
+  return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "b1", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [1, 0, 0]},
+               {"name": "b2", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [2, 0, 0]}],
+    "beams": [{"name": "one", "body1": "ground", "body2": "b1", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq"},
+              {"name": "two", "body1": ")" +
+         holder + R"(", "body2": "b2", "point1": [1, 0, 0],
+               "point2": [2, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq"}]})";
+}
+
+// A SUNDIALS CSC matrix holding the structure's pattern, its values drawn by `value(row, col)`.
+template <class F>
+void fill(const SparseStructure& s, SUNMatrix a, F&& value) {
+  const JacobianPattern& p = s.pattern();
+  sunindextype* starts = SUNSparseMatrix_IndexPointers(a);
+  sunindextype* rows = SUNSparseMatrix_IndexValues(a);
+  double* values = SUNSparseMatrix_Data(a);
+  for (long j = 0; j <= s.n(); ++j) starts[j] = p.column_starts[j];
+  for (long j = 0; j < s.n(); ++j)
+    for (long k = p.column_starts[j]; k < p.column_starts[j + 1]; ++k) {
+      rows[k] = p.rows[k];
+      values[k] = value(p.rows[k], j);
+    }
+}
+
+Eigen::MatrixXd dense(const SparseStructure& s, SUNMatrix a) {
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(s.n(), s.n());
+  const JacobianPattern& p = s.pattern();
+  const double* values = SUNSparseMatrix_Data(a);
+  for (long j = 0; j < s.n(); ++j)
+    for (long k = p.column_starts[j]; k < p.column_starts[j + 1]; ++k) m(p.rows[k], j) = values[k];
+  return m;
+}
+
+// Solves A x = b with the KLU solver; returns |A x - b| / (|A| |x|), or -1 when setup failed.
+double solve_residual(SUNLinearSolver solver, const SparseStructure& s, SUNMatrix a, SUNContext ctx,
+                      std::mt19937& rng) {
+  if (SUNLinSolSetup(solver, a) != SUNLS_SUCCESS) return -1.0;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  SerialVector b(s.n(), ctx), x(s.n(), ctx);
+  for (long i = 0; i < s.n(); ++i) b.data()[i] = u(rng);
+  EXPECT_EQ(SUNLinSolSolve(solver, a, x, b, 0.0), SUNLS_SUCCESS);
+  const Eigen::MatrixXd m = dense(s, a);
+  const Eigen::Map<const Eigen::VectorXd> xv(x.data(), s.n()), bv(b.data(), s.n());
+  return (m * xv - bv).norm() / (m.norm() * xv.norm());
+}
+
+TEST(KluSolver, SolvesFactorsRefactorsRepivotsAndReportsSingularMatrices) {
+  const Model model = scene_from_json(cantilever(6));
+  const SparseStructure s(model);
+  ASSERT_EQ(s.n(), 78);
+  SundialsContext ctx;
+  MatrixOwner a;
+  a.m = SUNSparseMatrix(s.n(), s.n(), s.pattern().nnz(), CSC_MAT, ctx);
+  LinearSolverOwner solver;
+  solver.s = make_klu_solver(std::shared_ptr<const SparseStructure>(&s, [](auto*) {}), ctx);
+  ASSERT_TRUE(solver.s);
+  ASSERT_EQ(SUNLinSolInitialize(solver.s), SUNLS_SUCCESS);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+
+  // A Newton matrix I - gamma J: strong diagonal. First setup factors with pivoting.
+  fill(s, a.m, [&](long r, long c) { return (r == c ? 10.0 : 0.0) + u(rng); });
+  const double first = solve_residual(solver.s, s, a.m, ctx, rng);
+  // New values of the same pattern: refactored with the first pivots.
+  fill(s, a.m, [&](long r, long c) { return (r == c ? 5.0 : 0.0) + u(rng); });
+  const double refactored = solve_residual(solver.s, s, a.m, ctx, rng);
+  // Values for which the first pivot order is nearly singular (a tiny diagonal): the solver must
+  // notice the poor pivots and factor afresh, or the residual would grow by the pivot growth.
+  fill(s, a.m, [&](long r, long c) { return r == c ? 1e-13 : u(rng); });
+  const double repivoted = solve_residual(solver.s, s, a.m, ctx, rng);
+  std::printf("relative residuals: factor %.2e, refactor %.2e, new pivots %.2e\n", first,
+              refactored, repivoted);
+  EXPECT_GE(first, 0.0);
+  EXPECT_LT(first, 1e-14);
+  EXPECT_GE(refactored, 0.0);
+  EXPECT_LT(refactored, 1e-14);
+  EXPECT_GE(repivoted, 0.0);
+  EXPECT_LT(repivoted, 1e-12);
+
+  // A zero column: a singular Newton matrix is a recoverable failure (the integrator retries with
+  // a smaller step), before and after a successful factorization.
+  fill(s, a.m, [&](long r, long c) { return c == 17 ? 0.0 : (r == c ? 10.0 : 0.0) + u(rng); });
+  EXPECT_EQ(SUNLinSolSetup(solver.s, a.m), SUNLS_PACKAGE_FAIL_REC);
+  EXPECT_EQ(SUNLinSolLastFlag(solver.s), SUNLS_PACKAGE_FAIL_REC);
+  fill(s, a.m, [&](long r, long c) { return (r == c ? 10.0 : 0.0) + u(rng); });
+  const double recovered = solve_residual(solver.s, s, a.m, ctx, rng);
+  EXPECT_GE(recovered, 0.0);
+  EXPECT_LT(recovered, 1e-14);
+
+  // A matrix of another size is refused, not read out of bounds.
+  MatrixOwner other;
+  other.m = SUNSparseMatrix(13, 13, 13, CSC_MAT, ctx);
+  EXPECT_EQ(SUNLinSolSetup(solver.s, other.m), SUNLS_ILL_INPUT);
+}
+
+TEST(SparseStructureCache, OneStructurePerTopology) {
+  SparseStructureCache cache;
+  // Same topology, other section and length: the same structure.
+  const Model a = scene_from_json(cantilever(6));
+  const Model b = scene_from_json(cantilever(6, 0.02, 2.5));
+  const auto sa = cache.get(a);
+  const auto sb = cache.get(b);
+  EXPECT_EQ(sa.get(), sb.get());
+  EXPECT_EQ(cache.analyses(), 1);
+  EXPECT_EQ(cache.reuses(), 1);
+  // Another segment count: another structure, and the first one is still there.
+  const Model c = scene_from_json(cantilever(7));
+  const auto sc = cache.get(c);
+  EXPECT_NE(sc.get(), sa.get());
+  EXPECT_EQ(sc->n(), 91);
+  EXPECT_EQ(cache.get(a).get(), sa.get());
+  EXPECT_EQ(cache.analyses(), 2);
+  EXPECT_EQ(cache.reuses(), 2);
+  // Same state count, other couplings: two bodies in a chain (ground - b1 - b2) and the same two
+  // bodies each held by ground (no coupling between them).
+  const Model chain = scene_from_json(two_bodies("b1"));
+  const Model separate = scene_from_json(two_bodies("ground"));
+  ASSERT_EQ(chain.n_states, separate.n_states);
+  const auto s_chain = cache.get(chain);
+  const auto s_separate = cache.get(separate);
+  EXPECT_NE(s_chain.get(), s_separate.get());
+  EXPECT_GT(s_chain->pattern().nnz(), s_separate->pattern().nnz());
+  EXPECT_EQ(cache.analyses(), 4);
+  // More topologies than the cache keeps: the least recently used is analysed again.
+  for (int n = 8; n < 8 + 8; ++n) cache.get(scene_from_json(cantilever(n)));
+  const long before = cache.analyses();
+  cache.get(a);
+  EXPECT_EQ(cache.analyses(), before + 1);
+}
+
+TEST(SparseStructureCache, ARunWithASharedStructureIsTheRunWithout) {
+  const Model model = scene_from_json(cantilever(6));
+  TransientOptions o = testing::options(0.02, 1e-3, 1e-7, 1e-10);
+  o.integrator.linear_solver = LinearSolverKind::kSparse;
+  o.integrator.method = "dirk";
+  const testing::TransientRun alone = testing::simulate(model, o);
+  SparseStructureCache cache;
+  o.structure_cache = &cache;
+  const Model other = scene_from_json(cantilever(6, 0.012, 1.1));
+  ASSERT_TRUE(testing::simulate(other, o).result.ok);  // analyses the topology
+  const testing::TransientRun shared = testing::simulate(model, o);
+  EXPECT_EQ(cache.analyses(), 1);
+  EXPECT_EQ(cache.reuses(), 1);
+  ASSERT_TRUE(alone.result.ok && shared.result.ok);
+  ASSERT_EQ(alone.samples.size(), shared.samples.size());
+  EXPECT_EQ(alone.result.stats.steps, shared.result.stats.steps);
+  for (size_t k = 0; k < alone.samples.size(); ++k)
+    for (size_t b = 0; b < model.bodies.size(); ++b) {
+      EXPECT_EQ(alone.samples[k].pose[b].c, shared.samples[k].pose[b].c);
+      EXPECT_EQ(alone.samples[k].q[b], shared.samples[k].q[b]);
+    }
+}
+
+}  // namespace
+}  // namespace beamrail

@@ -3,8 +3,6 @@
 #include <nvector/nvector_serial.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
-#include <cmath>
-#include <limits>
 
 namespace beamrail {
 namespace {
@@ -47,19 +45,17 @@ int setup(SUNLinearSolver s, SUNMatrix a) {
     return SUNLS_ILL_INPUT;
   }
   if (c.numeric) {
-    // The old pivots are kept while (1) the pivot growth stays within a factor 1e3 of what partial
-    // pivoting achieved (beyond it the factors lose digits: a test shows 4e-4 relative residuals
-    // with the old pivots where new ones give 1e-16), and (2) as in SUNDIALS' own KLU solver, the
-    // cheap reciprocal condition estimate stays above eps^(2/3) or the better estimate says the
-    // matrix is still well conditioned.
-    const double limit = std::pow(std::numeric_limits<double>::epsilon(), 2.0 / 3.0);
+    // The old pivots are kept while the pivot growth stays within a factor 1e3 of what partial
+    // pivoting achieved on the values it chose them for: beyond it the factors lose digits (a test
+    // shows 4e-4 relative residuals with the old pivots where new ones give 1e-16). SUNDIALS' own
+    // KLU solver tests the condition estimates instead; on a 10,000-body chain the reciprocal
+    // estimate min|u_ii| / max|u_ii| sits near 3e-11 for every Newton matrix (position and
+    // acceleration rows differ in scale by gamma k / m), so that test paid a condition estimate
+    // and a fresh factorization at 6 of 7 setups of a 100-step run, gaining no accuracy.
     const bool kept = klu_l_refactor(starts, rows, values, symbolic, c.numeric, &c.common) &&
+                      c.common.status == KLU_OK &&
                       klu_l_rgrowth(starts, rows, values, symbolic, c.numeric, &c.common) &&
-                      c.common.rgrowth >= 1e-3 * c.fresh_growth &&
-                      klu_l_rcond(symbolic, c.numeric, &c.common) &&
-                      (c.common.rcond >= limit ||
-                       (klu_l_condest(starts, values, symbolic, c.numeric, &c.common) &&
-                        c.common.condest <= 1.0 / limit));
+                      c.common.rgrowth >= 1e-3 * c.fresh_growth;
     if (kept) {
       c.last_flag = SUNLS_SUCCESS;
       return SUNLS_SUCCESS;

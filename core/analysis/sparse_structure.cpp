@@ -30,10 +30,11 @@ bool same_topology(int n_states, const std::vector<BlockPattern::Block>& blocks,
   return true;
 }
 
-}  // namespace
-
-JacobianPattern make_jacobian_pattern(const Model& model) {
-  const long n = model.n_states;
+// CSC structure of a matrix of size x size blocks on the model's block pattern, keeping the
+// entries (r, s) of each block for which structural(diagonal, r, s) holds.
+template <class Structural>
+JacobianPattern block_pattern(const Model& model, int size, Structural&& structural) {
+  const long n = static_cast<long>(size) * model.n_free();
   const auto& blocks = model.pattern.blocks;
   // Blocks by column body.
   std::vector<std::vector<int>> by_column(model.n_free());
@@ -43,17 +44,17 @@ JacobianPattern make_jacobian_pattern(const Model& model) {
     std::sort(list.begin(), list.end(),
               [&](int a, int b) { return blocks[a].row < blocks[b].row; });
   JacobianPattern p;
-  p.positions.assign(blocks.size() * kS * kS, -1);
+  p.positions.assign(blocks.size() * size * size, -1);
   p.column_starts.assign(n + 1, 0);
   for (long j = 0; j < n; ++j) {
-    const int body = static_cast<int>(j / kS), s = static_cast<int>(j % kS);
+    const int body = static_cast<int>(j / size), s = static_cast<int>(j % size);
     for (int b : by_column[body]) {
       const bool diagonal = blocks[b].row == blocks[b].col;
-      for (int r = 0; r < kS; ++r) {
+      for (int r = 0; r < size; ++r) {
         if (!structural(diagonal, r, s)) continue;
-        p.positions[static_cast<size_t>(b) * kS * kS + kS * r + s] =
+        p.positions[static_cast<size_t>(b) * size * size + size * r + s] =
             static_cast<long>(p.rows.size());
-        p.rows.push_back(static_cast<long>(kS) * blocks[b].row + r);
+        p.rows.push_back(static_cast<long>(size) * blocks[b].row + r);
       }
     }
     p.column_starts[j + 1] = static_cast<long>(p.rows.size());
@@ -61,13 +62,21 @@ JacobianPattern make_jacobian_pattern(const Model& model) {
   return p;
 }
 
-SparseStructure::SparseStructure(const Model& model) {
+}  // namespace
+
+JacobianPattern make_jacobian_pattern(const Model& model) {
+  return block_pattern(model, kS, structural);
+}
+
+SparseStructure::SparseStructure(const Model& model) : blocks_(model.pattern.blocks) {
   const auto start = std::chrono::steady_clock::now();
   pattern_ = make_jacobian_pattern(model);
+  reduced_ = block_pattern(model, kVelocityStates, [](bool, int, int) { return true; });
   klu_l_common common;
   klu_l_defaults(&common);
   common.ordering = 1;  // COLAMD: the blocks of the Newton matrix are unsymmetric
-  symbolic_ = klu_l_analyze(n(), pattern_.column_starts.data(), pattern_.rows.data(), &common);
+  symbolic_ =
+      klu_l_analyze(n_reduced(), reduced_.column_starts.data(), reduced_.rows.data(), &common);
   if (!symbolic_)
     throw std::runtime_error("KLU could not analyse the Jacobian pattern (status " +
                              std::to_string(common.status) + ")");

@@ -30,8 +30,14 @@ struct JacobianPattern {
 
 JacobianPattern make_jacobian_pattern(const Model& model);
 
-// The pattern and KLU's analysis of it. Immutable once made: KLU reads the symbolic analysis
-// without modifying it, so runs on several threads share one.
+// Per free body, 7 position states (c, q) and 6 velocity states (v, w).
+constexpr int kPositionStates = 7;
+constexpr int kVelocityStates = 6;
+
+// The pattern, the pattern of the velocity-level system the solver factors (the Schur complement
+// of the position states, 6 x 6 per block: the position rows of a Newton matrix I - gamma J only
+// couple a body to itself) and KLU's analysis of the latter. Immutable once made: KLU reads the
+// symbolic analysis without modifying it, so runs on several threads share one.
 class SparseStructure {
  public:
   // Throws std::runtime_error when KLU cannot analyse the pattern.
@@ -41,12 +47,17 @@ class SparseStructure {
   SparseStructure& operator=(const SparseStructure&) = delete;
 
   long n() const { return static_cast<long>(pattern_.column_starts.size()) - 1; }
-  const JacobianPattern& pattern() const { return pattern_; }
-  klu_l_symbolic* symbolic() const { return symbolic_; }
+  long n_reduced() const { return static_cast<long>(reduced_.column_starts.size()) - 1; }
+  const JacobianPattern& pattern() const { return pattern_; }  // the Jacobian, 13 x 13 blocks
+  const JacobianPattern& reduced() const { return reduced_; }  // velocity level, 6 x 6 blocks
+  const std::vector<BlockPattern::Block>& blocks() const { return blocks_; }
+  klu_l_symbolic* symbolic() const { return symbolic_; }         // of the reduced pattern
   double analysis_seconds() const { return analysis_seconds_; }  // pattern + KLU analysis
 
  private:
+  std::vector<BlockPattern::Block> blocks_;  // diagonal blocks first (block k = free body k)
   JacobianPattern pattern_;
+  JacobianPattern reduced_;
   klu_l_symbolic* symbolic_ = nullptr;
   double analysis_seconds_ = 0.0;
 };

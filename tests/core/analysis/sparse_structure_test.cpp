@@ -103,15 +103,29 @@ TEST(KluSolver, SolvesFactorsRefactorsRepivotsAndReportsSingularMatrices) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
 
-  // A Newton matrix I - gamma J: strong diagonal. First setup factors with pivoting.
-  fill(s, a.m, [&](long r, long c) { return (r == c ? 10.0 : 0.0) + u(rng); });
+  // Newton matrices I - gamma J of the equations of motion: position rows as the kinematics make
+  // them (dc/dt = v: 1 on the diagonal, -gamma in the velocity column; dq/dt: I - gamma dq'/dq
+  // and a 4 x 3 block in the w columns, scaled by gamma), velocity rows drawn by
+  // `velocity_rows(row, col)`.
+  const auto newton = [&](auto&& velocity_rows, double gamma = 1e-3) {
+    return [&, velocity_rows, gamma](long r, long col) {
+      const long lr = r % kStatesPerBody, lc = col % kStatesPerBody;
+      if (lr >= kPositionStates) return velocity_rows(r, col);
+      if (lr < 3) return lc == lr ? 1.0 : -gamma;
+      if (lc < kPositionStates) return (lc == lr ? 1.0 : 0.0) + gamma * u(rng);
+      return gamma * u(rng);
+    };
+  };
+  // Strong diagonal. The first setup factors with pivoting.
+  fill(s, a.m, newton([&](long r, long c) { return (r == c ? 10.0 : 0.0) + u(rng); }));
   const double first = solve_residual(solver.s, s, a.m, ctx, rng);
   // New values of the same pattern: refactored with the first pivots.
-  fill(s, a.m, [&](long r, long c) { return (r == c ? 5.0 : 0.0) + u(rng); });
+  fill(s, a.m, newton([&](long r, long c) { return (r == c ? 5.0 : 0.0) + u(rng); }));
   const double refactored = solve_residual(solver.s, s, a.m, ctx, rng);
   // Values for which the first pivot order is nearly singular (a tiny diagonal): the solver must
   // notice the poor pivots and factor afresh, or the residual would grow by the pivot growth.
-  fill(s, a.m, [&](long r, long c) { return r == c ? 1e-13 : u(rng); });
+  // (gamma 0: the velocity-level matrix is then the velocity block itself, tiny diagonal and all.)
+  fill(s, a.m, newton([&](long r, long c) { return r == c ? 1e-13 : u(rng); }, 0.0));
   const double repivoted = solve_residual(solver.s, s, a.m, ctx, rng);
   std::printf("relative residuals: factor %.2e, refactor %.2e, new pivots %.2e\n", first,
               refactored, repivoted);
@@ -122,12 +136,13 @@ TEST(KluSolver, SolvesFactorsRefactorsRepivotsAndReportsSingularMatrices) {
   EXPECT_GE(repivoted, 0.0);
   EXPECT_LT(repivoted, 1e-12);
 
-  // A zero column: a singular Newton matrix is a recoverable failure (the integrator retries with
-  // a smaller step), before and after a successful factorization.
-  fill(s, a.m, [&](long r, long c) { return c == 17 ? 0.0 : (r == c ? 10.0 : 0.0) + u(rng); });
+  // A zero column (body 1's v_x): a singular Newton matrix is a recoverable failure (the integrator
+  // retries with a smaller step), before and after a successful factorization.
+  const auto regular = newton([&](long r, long c) { return (r == c ? 10.0 : 0.0) + u(rng); });
+  fill(s, a.m, [&](long r, long c) { return c == 20 ? 0.0 : regular(r, c); });
   EXPECT_EQ(SUNLinSolSetup(solver.s, a.m), SUNLS_PACKAGE_FAIL_REC);
   EXPECT_EQ(SUNLinSolLastFlag(solver.s), SUNLS_PACKAGE_FAIL_REC);
-  fill(s, a.m, [&](long r, long c) { return (r == c ? 10.0 : 0.0) + u(rng); });
+  fill(s, a.m, newton([&](long r, long c) { return (r == c ? 10.0 : 0.0) + u(rng); }));
   const double recovered = solve_residual(solver.s, s, a.m, ctx, rng);
   EXPECT_GE(recovered, 0.0);
   EXPECT_LT(recovered, 1e-14);

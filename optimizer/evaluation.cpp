@@ -193,10 +193,9 @@ class Runner {
     v.atol = tight.integrator.atol;
     Data data(model_);
     Trajectory reference = trajectory_of(model_);
-    const TransientResult r =
-        run_transient(model_, tight, data, [&reference](const TransientSample& s, const Data& d) {
-          reference.record(s, d);
-        });
+    const TransientResult r = run_transient(
+        model_, tight, data,
+        [&reference](const TransientSample& s, const Data& d) { reference.record(s, d); });
     v.ok = r.ok;
     v.message = r.message;
     v.stats = r.stats;

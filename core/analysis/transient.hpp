@@ -32,18 +32,18 @@ struct IntegratorOptions {
   double atol = 1e-9;          // absolute tolerance (states in m, -, m/s, rad/s)
   JacobianKind jacobian = JacobianKind::kExact;
   LinearSolverKind linear_solver = LinearSolverKind::kAuto;
-  int max_order = 5;          // BDF order limit 1..5 (Adams: 1..12)
+  int max_order = 5;                       // BDF order limit 1..5 (Adams: 1..12)
   bool stability_limit_detection = false;  // CVODE's BDF stability limit detection
-  double max_step = 0.0;      // [s]; 0: no limit
-  double initial_step = 0.0;  // [s]; 0: the integrator's estimate
-  long max_steps = 10000000;  // total step budget over the run
+  double max_step = 0.0;                   // [s]; 0: no limit
+  double initial_step = 0.0;               // [s]; 0: the integrator's estimate
+  long max_steps = 10000000;               // total step budget over the run
 };
 
 struct TransientOptions {
   double t_end = 1.0;         // [s]
   double output_step = 0.01;  // [s]
   IntegratorOptions integrator;
-  double max_seconds = 0.0;   // wall-clock budget; 0: none. Exceeding it ends the run as a timeout
+  double max_seconds = 0.0;  // wall-clock budget; 0: none. Exceeding it ends the run as a timeout
   // Shares the sparse Jacobian structure and KLU ordering between runs of one topology (designs,
   // reruns); nullptr: this run analyses its own.
   SparseStructureCache* structure_cache = nullptr;
@@ -68,7 +68,7 @@ struct SolverStats {
 
 struct TransientResult {
   bool ok = false;
-  bool timed_out = false;     // stopped by max_seconds
+  bool timed_out = false;      // stopped by max_seconds
   std::string linear_solver;   // dense | sparse | none
   long jacobian_nonzeros = 0;  // stored entries of the sparse Jacobian
   std::string message;         // why it stopped early, when !ok

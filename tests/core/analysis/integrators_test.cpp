@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <string>
 
+#include "tests/support/reference_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 
 namespace beamrail {
@@ -18,19 +19,7 @@ using testing::scene_from_json;
 using testing::simulate;
 using testing::TransientRun;
 
-// A 1 m steel cantilever of 10 mm square section in `segments` segments with a 1 N step load on
-// its tip body: every bending, axial and rotary mode of the chain is excited.
-std::string cantilever(int segments) {
-  return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "tip", "position": [1, 0, 0]}],
-    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
-               "segments": )" +
-         std::to_string(segments) + R"(}],
-    "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0],
-               "time": {"type": "step", "at": 0.0}}]})";
-}
+using testing::reference_cantilever;
 
 // Largest distance of the tip body from its reference position over the common samples,
 // relative to the largest tip motion in the reference.
@@ -60,7 +49,7 @@ struct Family {
 };
 
 TEST(Integrators, EveryFamilyIntegratesTheSameMotion) {
-  const Model model = scene_from_json(cantilever(4));
+  const Model model = scene_from_json(reference_cantilever(4));
   const int tip = body_index(model, "tip");
   ASSERT_GE(tip, 0);
   TransientOptions tight = options(0.05, 5e-4, 1e-11, 1e-12);
@@ -114,7 +103,7 @@ TEST(Integrators, EveryFamilyIntegratesTheSameMotion) {
 
 // Dense LU and sparse KLU solve the same Newton systems: the runs differ only by rounding.
 TEST(Integrators, DenseAndSparseSolversGiveTheSameRun) {
-  const Model model = scene_from_json(cantilever(6));
+  const Model model = scene_from_json(reference_cantilever(6));
   const int tip = body_index(model, "tip");
   TransientOptions o = options(0.02, 1e-3, 1e-7, 1e-10);
   o.integrator.linear_solver = LinearSolverKind::kDense;
@@ -138,8 +127,8 @@ TEST(Integrators, DenseAndSparseSolversGiveTheSameRun) {
 
 TEST(Integrators, AutomaticLinearSolverSwitchesToSparseAtTheMeasuredSize) {
   TransientOptions o = options(1e-3, 1e-3, 1e-6, 1e-9);
-  const Model one = scene_from_json(cantilever(1));  // 13 states
-  const Model two = scene_from_json(cantilever(2));  // 26 states
+  const Model one = scene_from_json(reference_cantilever(1));  // 13 states
+  const Model two = scene_from_json(reference_cantilever(2));  // 26 states
   ASSERT_EQ(one.n_states, 13);
   ASSERT_EQ(two.n_states, 26);
   ASSERT_GE(two.n_states, kSparseStateThreshold);
@@ -149,7 +138,7 @@ TEST(Integrators, AutomaticLinearSolverSwitchesToSparseAtTheMeasuredSize) {
 }
 
 TEST(Integrators, WallClockBudgetEndsARunAsATimeoutAndKeepsItsSamples) {
-  const Model model = scene_from_json(cantilever(10));
+  const Model model = scene_from_json(reference_cantilever(10));
   TransientOptions o = options(100.0, 1e-3, 1e-10, 1e-12);  // hours of work at this tolerance
   o.max_seconds = 0.2;
   const TransientRun run = simulate(model, o);

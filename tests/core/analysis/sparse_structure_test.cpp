@@ -15,6 +15,7 @@
 
 #include "core/analysis/klu_solver.hpp"
 #include "core/analysis/sundials_support.hpp"
+#include "tests/support/reference_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 
 namespace beamrail {
@@ -22,22 +23,7 @@ namespace {
 
 using testing::scene_from_json;
 
-// A 1 m steel cantilever in `segments` segments of a square section `width` wide, `length` long.
-std::string cantilever(int segments, double width = 0.01, double length = 1.0) {
-  const std::string w = std::to_string(width), l = std::to_string(length);
-  return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-    "sections": {"sq": {"shape": "rectangle", "width": )" +
-         w + R"(, "height": )" + w + R"(}},
-    "bodies": [{"name": "tip", "position": [)" +
-         l + R"(, 0, 0]}],
-    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [)" +
-         l + R"(, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq",
-               "segments": )" +
-         std::to_string(segments) + R"(}],
-    "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0],
-               "time": {"type": "step", "at": 0.0}}]})";
-}
+using testing::reference_cantilever;
 
 // Bodies b1 and b2, b1 held by ground and b2 by `holder`.
 std::string two_bodies(const std::string& holder) {
@@ -90,7 +76,7 @@ double solve_residual(SUNLinearSolver solver, const SparseStructure& s, SUNMatri
 }
 
 TEST(KluSolver, SolvesFactorsRefactorsRepivotsAndReportsSingularMatrices) {
-  const Model model = scene_from_json(cantilever(6));
+  const Model model = scene_from_json(reference_cantilever(6));
   const SparseStructure s(model);
   ASSERT_EQ(s.n(), 78);
   SundialsContext ctx;
@@ -156,15 +142,15 @@ TEST(KluSolver, SolvesFactorsRefactorsRepivotsAndReportsSingularMatrices) {
 TEST(SparseStructureCache, OneStructurePerTopology) {
   SparseStructureCache cache;
   // Same topology, other section and length: the same structure.
-  const Model a = scene_from_json(cantilever(6));
-  const Model b = scene_from_json(cantilever(6, 0.02, 2.5));
+  const Model a = scene_from_json(reference_cantilever(6));
+  const Model b = scene_from_json(reference_cantilever(6, 0.02, 2.5));
   const auto sa = cache.get(a);
   const auto sb = cache.get(b);
   EXPECT_EQ(sa.get(), sb.get());
   EXPECT_EQ(cache.analyses(), 1);
   EXPECT_EQ(cache.reuses(), 1);
   // Another segment count: another structure, and the first one is still there.
-  const Model c = scene_from_json(cantilever(7));
+  const Model c = scene_from_json(reference_cantilever(7));
   const auto sc = cache.get(c);
   EXPECT_NE(sc.get(), sa.get());
   EXPECT_EQ(sc->n(), 91);
@@ -182,21 +168,21 @@ TEST(SparseStructureCache, OneStructurePerTopology) {
   EXPECT_GT(s_chain->pattern().nnz(), s_separate->pattern().nnz());
   EXPECT_EQ(cache.analyses(), 4);
   // More topologies than the cache keeps: the least recently used is analysed again.
-  for (int n = 8; n < 8 + 8; ++n) cache.get(scene_from_json(cantilever(n)));
+  for (int n = 8; n < 8 + 8; ++n) cache.get(scene_from_json(reference_cantilever(n)));
   const long before = cache.analyses();
   cache.get(a);
   EXPECT_EQ(cache.analyses(), before + 1);
 }
 
 TEST(SparseStructureCache, ARunWithASharedStructureIsTheRunWithout) {
-  const Model model = scene_from_json(cantilever(6));
+  const Model model = scene_from_json(reference_cantilever(6));
   TransientOptions o = testing::options(0.02, 1e-3, 1e-7, 1e-10);
   o.integrator.linear_solver = LinearSolverKind::kSparse;
   o.integrator.method = "dirk";
   const testing::TransientRun alone = testing::simulate(model, o);
   SparseStructureCache cache;
   o.structure_cache = &cache;
-  const Model other = scene_from_json(cantilever(6, 0.012, 1.1));
+  const Model other = scene_from_json(reference_cantilever(6, 0.012, 1.1));
   ASSERT_TRUE(testing::simulate(other, o).result.ok);  // analyses the topology
   const testing::TransientRun shared = testing::simulate(model, o);
   EXPECT_EQ(cache.analyses(), 1);

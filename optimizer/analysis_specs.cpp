@@ -17,7 +17,7 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
                      IntegratorOptions& io) {
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return;
-  if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk"})) io.method = *m;
+  if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk", "modal"})) io.method = *m;
   if (const auto t = r.string("table", false)) {
     if (io.method != "dirk" && io.method != "erk")
       r.error("table", "a Butcher table applies to the \"dirk\" and \"erk\" methods");

@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "core/analysis/klu_solver.hpp"
+#include "core/analysis/modal_integrator.hpp"
 
 namespace beamrail {
 namespace {
@@ -274,6 +275,7 @@ std::unique_ptr<Integrator> make_integrator(const IntegratorOptions& options, Od
     return build<Cvode>(options, context, sunctx, y0, error);
   if (options.method == "dirk") return build<ArkodeImplicit>(options, context, sunctx, y0, error);
   if (options.method == "erk") return build<ArkodeExplicit>(options, context, sunctx, y0, error);
+  if (options.method == "modal") return make_modal_integrator(options, context, y0, error);
   *error = "unknown integrator method \"" + options.method + "\"";
   return nullptr;
 }

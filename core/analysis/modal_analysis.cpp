@@ -79,38 +79,6 @@ std::vector<std::vector<int>> coupled_groups(const Model& model) {
   return groups;
 }
 
-// Dense solution of one group, K x = w^2 M x. Eigenvalues come out accurate to ~eps lambda_max
-// absolute, so when the spectrum spans many decades and K is positive definite (no rigid modes),
-// the lower half is taken from the inverse problem M x = (1/w^2) K x, accurate to ~eps lambda_min.
-bool solve_group(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& md, Eigen::VectorXd& values,
-                 Eigen::MatrixXd& vectors) {
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(kd, md);
-  if (eig.info() != Eigen::Success) return false;
-  values = eig.eigenvalues();  // ascending
-  vectors = eig.eigenvectors();
-  const Eigen::Index n = values.size();
-  const double top = values.cwiseAbs().maxCoeff();
-  if (n < 2 || !(values(0) > kRigidModeThreshold * top) || values(n - 1) < 1e6 * values(0))
-    return true;
-  const Eigen::LLT<Eigen::MatrixXd> kf(kd);
-  const Eigen::LLT<Eigen::MatrixXd> mf(md);
-  if (kf.info() != Eigen::Success || mf.info() != Eigen::Success) return true;
-  // With M = L L^T: B = L^T K^-1 L has eigenvalues 1/w^2 and eigenvectors y = L^T x.
-  const Eigen::MatrixXd l = mf.matrixL();
-  Eigen::MatrixXd b = l.transpose() * kf.solve(l);
-  b = 0.5 * (b + b.transpose()).eval();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> inv(b);
-  if (inv.info() != Eigen::Success || !(inv.eigenvalues().minCoeff() > 0.0)) return true;
-  const Eigen::MatrixXd x = mf.matrixU().solve(inv.eigenvectors());
-  const double middle = std::sqrt(values(0) * values(n - 1));
-  for (Eigen::Index i = 0; i < n && values(i) < middle; ++i) {
-    const Eigen::Index j = n - 1 - i;  // 1/w^2 ascending: the i-th smallest w^2 is last but i
-    values(i) = 1.0 / inv.eigenvalues()(j);
-    vectors.col(i) = x.col(j);
-  }
-  return true;
-}
-
 bool solve_dense(const Model& model, const SparseMatrix& k, const SparseMatrix& m, int wanted,
                  ModalResult& result) {
   const Eigen::MatrixXd kd(k), md(m);
@@ -130,7 +98,7 @@ bool solve_dense(const Model& model, const SparseMatrix& k, const SparseMatrix& 
       }
     Eigen::VectorXd gv;
     Eigen::MatrixXd gx;
-    if (!solve_group(kg, mg, gv, gx)) {
+    if (!solve_dense_eigenproblem(kg, mg, gv, gx)) {
       result.message = "the dense eigensolver failed";
       return false;
     }
@@ -188,6 +156,35 @@ bool solve_shift_invert(const SparseMatrix& k, const SparseMatrix& m, int wanted
 }
 
 }  // namespace
+
+bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& md,
+                              Eigen::VectorXd& values, Eigen::MatrixXd& vectors) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(kd, md);
+  if (eig.info() != Eigen::Success) return false;
+  values = eig.eigenvalues();  // ascending
+  vectors = eig.eigenvectors();
+  const Eigen::Index n = values.size();
+  const double top = values.cwiseAbs().maxCoeff();
+  if (n < 2 || !(values(0) > kRigidModeThreshold * top) || values(n - 1) < 1e6 * values(0))
+    return true;
+  const Eigen::LLT<Eigen::MatrixXd> kf(kd);
+  const Eigen::LLT<Eigen::MatrixXd> mf(md);
+  if (kf.info() != Eigen::Success || mf.info() != Eigen::Success) return true;
+  // With M = L L^T: B = L^T K^-1 L has eigenvalues 1/w^2 and eigenvectors y = L^T x.
+  const Eigen::MatrixXd l = mf.matrixL();
+  Eigen::MatrixXd b = l.transpose() * kf.solve(l);
+  b = 0.5 * (b + b.transpose()).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> inv(b);
+  if (inv.info() != Eigen::Success || !(inv.eigenvalues().minCoeff() > 0.0)) return true;
+  const Eigen::MatrixXd x = mf.matrixU().solve(inv.eigenvectors());
+  const double middle = std::sqrt(values(0) * values(n - 1));
+  for (Eigen::Index i = 0; i < n && values(i) < middle; ++i) {
+    const Eigen::Index j = n - 1 - i;  // 1/w^2 ascending: the i-th smallest w^2 is last but i
+    values(i) = 1.0 / inv.eigenvalues()(j);
+    vectors.col(i) = x.col(j);
+  }
+  return true;
+}
 
 const Mode* elastic_mode(const ModalResult& result, int k) {
   int count = 0;

@@ -50,6 +50,14 @@ constexpr double kRigidModeThreshold = 1e-12;
 // Solves the eigenproblem about the configuration in data.pose. Never throws.
 ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& data);
 
+// Dense solution of K x = w^2 M x (K symmetric, M symmetric positive definite): every eigenvalue,
+// ascending, and M-normalized eigenvectors. Eigenvalues come out accurate to ~eps lambda_max
+// absolute, so when the spectrum spans many decades and K is positive definite (no rigid modes),
+// the lower half is taken from the inverse problem M x = (1/w^2) K x, accurate to ~eps lambda_min.
+// False when Eigen's solver fails.
+bool solve_dense_eigenproblem(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m,
+                              Eigen::VectorXd& values, Eigen::MatrixXd& vectors);
+
 // The k-th elastic mode (1-based), or nullptr.
 const Mode* elastic_mode(const ModalResult& result, int k);
 

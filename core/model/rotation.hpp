@@ -113,4 +113,21 @@ inline Mat4 quat_right_product_matrix(const Vec3& w) {
   return m;
 }
 
+// d theta / dt of the rotation vector theta of A = exp([theta]x) A0 when the body turns at the
+// global angular velocity omega (dA/dt = [omega]x A): the inverse left Jacobian of SO(3),
+//   dtheta/dt = omega - 1/2 theta x omega + c(|theta|) theta x (theta x omega),
+//   c(a) = 1/a^2 - (1 + cos a) / (2 a sin a)   (1/12 + a^2/720 near 0); valid for |theta| < 2 pi.
+inline Vec3 rotation_vector_rate(const Vec3& theta, const Vec3& omega) {
+  const double a2 = theta.squaredNorm();
+  double c;
+  if (a2 < 1e-4) {
+    c = 1.0 / 12.0 + a2 / 720.0 + a2 * a2 / 30240.0;
+  } else {
+    const double a = std::sqrt(a2);
+    c = 1.0 / a2 - (1.0 + std::cos(a)) / (2.0 * a * std::sin(a));
+  }
+  const Vec3 tw = theta.cross(omega);
+  return omega - 0.5 * tw + c * theta.cross(tw);
+}
+
 }  // namespace beamrail

@@ -1,4 +1,4 @@
-// The integrator families (CVODE bdf/adams, ARKODE dirk/erk), the linear solvers (dense, sparse
+// The integrator families (CVODE bdf/adams, ARKODE dirk/erk, the modal exponential method), the linear solvers (dense, sparse
 // KLU) and the Jacobian kinds (exact, finite differences) must all integrate the same motion: each
 // is compared with a tight reference run on a segmented cantilever hit by a step load. Also: the
 // automatic choice of the linear solver, and the wall-clock budget ending a run as a timeout.
@@ -69,6 +69,7 @@ TEST(Integrators, EveryFamilyIntegratesTheSameMotion) {
        JacobianKind::kExact, 5},
       {"erk default", "erk", "", LinearSolverKind::kAuto, JacobianKind::kExact, 5},
       {"erk VERNER", "erk", "VERNER_8_5_6", LinearSolverKind::kAuto, JacobianKind::kExact, 5},
+      {"modal", "modal", "", LinearSolverKind::kAuto, JacobianKind::kExact, 5},
   };
   for (const Family& f : families) {
     TransientOptions o = options(0.05, 5e-4, 1e-8, 1e-10);
@@ -87,7 +88,10 @@ TEST(Integrators, EveryFamilyIntegratesTheSameMotion) {
     // rtol 1e-8 on positions of about 1 m allows local errors near 1e-8 m against a tip motion
     // of about 1e-3 m: 1e-5 relative leaves room for error accumulation over the steps.
     EXPECT_LT(e, 1e-5) << f.label;
-    if (std::string(f.method) == "erk") {
+    if (std::string(f.method) == "modal") {
+      EXPECT_EQ(run.result.linear_solver, "modal") << f.label;
+      EXPECT_EQ(run.result.stats.jacobian_evaluations, 1) << f.label;
+    } else if (std::string(f.method) == "erk") {
       EXPECT_EQ(run.result.linear_solver, "none") << f.label;
       EXPECT_EQ(run.result.stats.jacobian_evaluations, 0) << f.label;
     } else if (std::string(f.method) != "adams") {

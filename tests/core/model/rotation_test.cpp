@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
+
 #include "tests/support/random_elements.hpp"
 
 namespace beamrail {
@@ -54,6 +57,34 @@ TEST(Rotation, IncrementJacobianMatchesFiniteDifferences) {
       EXPECT_LT((theta - jac.col(k)).norm(), 1e-7 * (1.0 + jac.col(k).norm()));
     }
   }
+}
+
+TEST(Rotation, RotationVectorRateMatchesFiniteDifferences) {
+  // A(t) = exp([omega]x t) exp([theta]x): d/dt log(A) at t = 0 against central differences, over
+  // angles from the series branch (1e-3 rad) to 2.8 rad.
+  testing::Random rng(5);
+  double worst = 0.0;
+  for (double angle : {1e-3, 0.01, 0.3, 1.0, 2.0, 2.8}) {
+    for (int i = 0; i < 20; ++i) {
+      const Vec3 theta = angle * rng.vec3(1.0).normalized();
+      const Vec3 omega = rng.vec3(1.0);
+      const Mat3 a0 = rotation_matrix<double>(quat_from_rotation_vector(theta));
+      const double h = 1e-6;
+      const auto at = [&](double t) {
+        return rotation_vector(rotation_matrix<double>(quat_from_rotation_vector(omega * t)) * a0);
+      };
+      const Vec3 fd = (at(h) - at(-h)) / (2 * h);
+      const Vec3 rate = rotation_vector_rate(theta, omega);
+      worst = std::max(worst, (rate - fd).norm() / omega.norm());
+      EXPECT_LT((rate - fd).norm(), 1e-8 * omega.norm()) << "angle " << angle;
+    }
+  }
+  std::printf("rotation_vector_rate vs finite differences: worst relative difference %.2e\n",
+              worst);
+  // Near zero it is omega - theta x omega / 2 to first order.
+  const Vec3 small(1e-9, -2e-9, 3e-9), omega(0.3, -0.1, 0.7);
+  EXPECT_LT((rotation_vector_rate(small, omega) - (omega - 0.5 * small.cross(omega))).norm(),
+            1e-17);
 }
 
 TEST(Rotation, QuaternionProductMatrices) {

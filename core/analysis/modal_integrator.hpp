@@ -1,0 +1,45 @@
+// The "modal" integrator: an exponential Runge-Kutta method in the modal basis of the initial
+// linearization, for small motions about the initial configuration (vibration of stiff
+// structures).
+//
+// Generalized coordinates per free body: x = (dc, theta) with c = c0 + dc and A = exp([theta]x) A0
+// (global rotation vector), velocities u = (v, omega) (global). With the mass matrix M0 and the
+// symmetric part K0 of the tangent stiffness at the initial state, and the M0-normalized modes
+// Phi (Phi^T K0 Phi = diag(lambda), Phi^T M0 Phi = I), x = Phi eta, u = Phi nu and
+//   d eta / dt = nu                   + Phi^T M0 (dtheta/dt - omega, rotation rows only)
+//   d nu / dt  = -lambda eta          + Phi^T M0 a(x, u) + lambda eta,
+// a being the exact accelerations (dv/dt, domega/dt) of the equations of motion. Each mode's
+// linear part [[0, 1], [-lambda, 0]] is integrated exactly (phi functions of 2 x 2 blocks); the
+// rest (nonlinearity, load changes, damping, the non-symmetric part) by the stiff-order-4
+// exponential Runge-Kutta method of Hochbruck and Ostermann (2005). Steps are controlled by step
+// doubling (error of the two half steps, Richardson estimate), measured in the physical states.
+//
+// Cost: one dense eigenproblem (n_dofs^3) at set-up, then two dense n_dofs x n_dofs products per
+// stage; hence a size limit. Accuracy degrades with the size of the motion: past kMaxRotation the
+// run stops with a message naming the body.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "core/analysis/integrators.hpp"
+
+namespace beamrail {
+
+// Largest scene the modal integrator accepts [degrees of freedom = 6 per free body].
+inline constexpr int kModalIntegratorMaxDofs = 1200;
+// Largest rotation of a body from its initial orientation the method follows [rad].
+inline constexpr double kModalIntegratorMaxRotation = 1.0;
+
+// g_m(x) = sum_j (-x)^j / (2j + m)!, m = 0..4, at x = lambda tau^2: the phi functions of a mode
+// block B = [[0, 1], [-lambda, 0]] are phi_k(tau B) = g_k I + tau g_{k+1} B (B^2 = -lambda I).
+// Any sign of lambda (negative: an unstable mode).
+std::array<double, 5> oscillator_g(double x);
+
+// The modal integrator for the system in `context`, starting at (0, y0).
+std::unique_ptr<Integrator> make_modal_integrator(const IntegratorOptions& options,
+                                                  OdeContext& context, N_Vector y0,
+                                                  std::string* error);
+
+}  // namespace beamrail

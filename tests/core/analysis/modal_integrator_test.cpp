@@ -1,0 +1,253 @@
+// The modal (exponential) integrator: its phi functions against closed forms, exactness on a
+// linear motion, agreement with a tight reference on planar and 3-D motions and across load
+// breakpoints, its observed order of convergence, and its limits (scene size, large rotations).
+#include "core/analysis/modal_integrator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "tests/support/reference_cantilever.hpp"
+#include "tests/support/transient_run.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::options;
+using testing::reference_cantilever;
+using testing::scene_from_json;
+using testing::simulate;
+using testing::TransientRun;
+
+// Largest distance of body `b` from its reference position relative to its largest motion.
+double body_error(const TransientRun& run, const TransientRun& reference, int b) {
+  double error = 0.0, motion = 0.0;
+  const Vec3 start = reference.samples.front().pose[b].c;
+  for (const auto& s : reference.samples) motion = std::max(motion, (s.pose[b].c - start).norm());
+  EXPECT_EQ(run.samples.size(), reference.samples.size());
+  const size_t n = std::min(run.samples.size(), reference.samples.size());
+  for (size_t k = 0; k < n; ++k)
+    error = std::max(error, (run.samples[k].pose[b].c - reference.samples[k].pose[b].c).norm());
+  return error / motion;
+}
+
+int body_index(const Model& model, const std::string& name) {
+  for (size_t i = 0; i < model.bodies.size(); ++i)
+    if (model.bodies[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+TransientOptions modal(double t_end, double output_step, double rtol, double atol) {
+  TransientOptions o = options(t_end, output_step, rtol, atol);
+  o.integrator.method = "modal";
+  return o;
+}
+
+TEST(ModalIntegrator, OscillatorFunctionsMatchTheirClosedForms) {
+  // g_m(x) = sum_j (-x)^j / (2j+m)!; with s = sqrt(x): g0 = cos s, g1 = sin s / s,
+  // g2 = (1 - cos s) / x, g3 = (s - sin s) / s^3, g4 = (x/2 - 1 + cos s) / x^2 (cosh, sinh for
+  // x < 0). Closed forms in long double away from 0, the series in long double near it.
+  double worst = 0.0;
+  for (double x : {-400.0, -30.0, -4.5, -3.9, -0.7, -1e-9, 0.0, 1e-12, 1e-3, 0.5, 3.99, 4.01, 17.0,
+                   250.0, 1e4, 3.3e7}) {
+    const std::array<double, 5> g = oscillator_g(x);
+    long double ref[5];
+    if (std::abs(x) > 2.0) {
+      const long double xl = x, s = std::sqrt(std::abs(xl));
+      const long double c = x > 0 ? std::cos(s) : std::cosh(s);
+      const long double sn = x > 0 ? std::sin(s) : std::sinh(s);
+      ref[0] = c;
+      ref[1] = sn / s;
+      ref[2] = (1 - c) / xl;
+      ref[3] = x > 0 ? (s - sn) / (s * s * s) : (sn - s) / (s * s * s);
+      ref[4] = (xl / 2 - 1 + c) / (xl * xl);
+    } else {
+      for (int m = 0; m < 5; ++m) {
+        long double fact = 1, sum = 0, term;
+        for (int i = 2; i <= m; ++i) fact *= i;
+        term = 1 / fact;
+        for (int j = 0; j < 40; ++j) {
+          sum += term;
+          term *= -static_cast<long double>(x) / ((2 * j + m + 1) * (2 * j + m + 2));
+        }
+        ref[m] = sum;
+      }
+    }
+    for (int m = 0; m < 5; ++m) {
+      // Relative to the size of the terms (g0, g1 oscillate through zero for large x). Rounding
+      // x to double moves s = sqrt(x) by eps s / 2, hence cos s by up to that much: the bound
+      // grows with s.
+      const double scale = m < 2 ? std::max(1.0, std::abs(static_cast<double>(ref[m])))
+                                 : std::abs(static_cast<double>(ref[m]));
+      const double e = std::abs(g[m] - static_cast<double>(ref[m])) / scale;
+      const double s = std::sqrt(std::abs(x));
+      worst = std::max(worst, e / (1.0 + s));
+      EXPECT_LT(e, 1e-13 * (1.0 + s)) << "x " << x << " m " << m;
+    }
+  }
+  std::printf("oscillator phi functions: worst relative error / (1 + sqrt|x|) %.1e\n", worst);
+}
+
+// A point mass on a massless beam pulled along the beam's axis: the motion stays on the axis, the
+// beam force is linear in the stretch, and the response to the step load is the closed form
+// x(t) = F/k (1 - cos w t). The integrator treats the linear part exactly, so the error is
+// rounding, whatever the step.
+TEST(ModalIntegrator, AxialStepResponseIsExact) {
+  const Model model = scene_from_json(R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "m", "position": [1, 0, 0], "mass": 2.0,
+                "inertia": [0.01, 0.01, 0.01]}],
+    "beams": [{"name": "b", "body1": "ground", "body2": "m", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq"}],
+    "loads": [{"type": "force", "body": "m", "value": [100, 0, 0],
+               "time": {"type": "step", "at": 0.0}}]})");
+  const int m = body_index(model, "m");
+  const double k = 2.1e11 * 1e-4 / 1.0, w = std::sqrt(k / 2.0), amplitude = 100.0 / k;
+  const TransientRun run = simulate(model, modal(0.01, 1e-4, 1e-8, 1e-12));
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  double worst = 0.0;
+  for (const auto& s : run.samples) {
+    const double exact = amplitude * (1.0 - std::cos(w * s.sample.t));
+    worst = std::max(worst, std::abs(s.pose[m].c.x() - 1.0 - exact));
+    EXPECT_LT(s.pose[m].c.tail<2>().norm(), 1e-20);
+  }
+  std::printf(
+      "axial step: worst error %.2e of amplitude %.2e (w = %.0f rad/s, %.1f periods), "
+      "%ld steps for %zu outputs\n",
+      worst, amplitude, w, w * 0.01 / (2 * M_PI), run.result.stats.steps, run.samples.size() - 1);
+  // Positions near 1 m: rounding of c is 1.1e-16; a few ulps over 100 outputs.
+  EXPECT_LT(worst, 1e-14);
+  // Steps as long as the outputs allow (two half steps per output interval).
+  EXPECT_LE(run.result.stats.steps, 2 * static_cast<long>(run.samples.size() - 1));
+  EXPECT_EQ(run.result.linear_solver, "modal");
+  EXPECT_EQ(run.result.stats.jacobian_evaluations, 1);
+}
+
+// The reference cantilever (planar bending) and a 3-D variant (oblique tip load and a tip torque:
+// bending in two planes plus torsion, so the rotation-vector kinematics are exercised) against
+// tight ERK runs.
+TEST(ModalIntegrator, AgreesWithATightReference) {
+  std::string three_d = reference_cantilever(6);
+  const std::string planar_load = R"("value": [0, -1, 0])";
+  three_d.replace(three_d.find(planar_load), planar_load.size(), R"("value": [0, -1, 0.7])");
+  three_d.replace(three_d.rfind("]}"), 2,
+                  R"(, {"type": "torque", "body": "tip", "value": [0.3, 0, 0],
+                       "time": {"type": "step", "at": 0.0}}]})");
+  struct Case {
+    const char* label;
+    std::string json;
+  } cases[] = {{"planar, 6 segments", reference_cantilever(6)}, {"3-D, 6 segments", three_d}};
+  for (const Case& c : cases) {
+    const Model model = scene_from_json(c.json);
+    const int tip = body_index(model, "tip");
+    TransientOptions tight = options(0.05, 5e-4, 1e-11, 1e-12);
+    tight.integrator.method = "erk";
+    tight.integrator.table = "VERNER_8_5_6";
+    const TransientRun reference = simulate(model, tight);
+    ASSERT_TRUE(reference.result.ok) << reference.result.message;
+    for (double rtol : {1e-6, 1e-8}) {
+      const TransientRun run = simulate(model, modal(0.05, 5e-4, rtol, 1e-2 * rtol));
+      ASSERT_TRUE(run.result.ok) << c.label << ": " << run.result.message;
+      const double e = body_error(run, reference, tip);
+      // Largest angle between the tip body's orientations.
+      double angle = 0.0;
+      for (size_t k = 0; k < run.samples.size(); ++k) {
+        const Mat3 d = run.samples[k].pose[tip].A * reference.samples[k].pose[tip].A.transpose();
+        angle = std::max(angle, rotation_vector(d).norm());
+      }
+      std::printf("%-20s rtol %.0e: tip error %.2e, orientation %.1e rad, steps %ld, rhs %ld\n",
+                  c.label, rtol, e, angle, run.result.stats.steps,
+                  run.result.stats.rhs_evaluations);
+      // The error per unit tolerance stays below 1 (the step-doubling estimate is conservative).
+      EXPECT_LT(e, rtol) << c.label;
+      EXPECT_LT(angle, 1e-2 * rtol) << c.label;
+    }
+  }
+}
+
+TEST(ModalIntegrator, RestartsAtLoadBreakpoints) {
+  // A triangular tip pulse (0 -> 1 N at 5 ms -> 0 at 10 ms): two restarts, then free vibration.
+  std::string json = reference_cantilever(4);
+  const std::string step = R"({"type": "step", "at": 0.0})";
+  json.replace(json.find(step), step.size(),
+               R"({"type": "table", "t": [0, 0.005, 0.01], "v": [0, 1, 0]})");
+  const Model model = scene_from_json(json);
+  const int tip = body_index(model, "tip");
+  TransientOptions tight = options(0.04, 5e-4, 1e-11, 1e-12);
+  tight.integrator.method = "erk";
+  tight.integrator.table = "VERNER_8_5_6";
+  const TransientRun reference = simulate(model, tight);
+  const TransientRun run = simulate(model, modal(0.04, 5e-4, 1e-7, 1e-9));
+  ASSERT_TRUE(reference.result.ok && run.result.ok) << run.result.message;
+  const double e = body_error(run, reference, tip);
+  std::printf("pulse with two breakpoints: tip error %.2e, steps %ld\n", e, run.result.stats.steps);
+  EXPECT_LT(e, 1e-7);
+}
+
+// Fixed steps (a tolerance that never rejects) halved four times on the reference cantilever in 4
+// segments: the observed order of the error in the tip motion.
+TEST(ModalIntegrator, ObservedOrderOfConvergence) {
+  const Model model = scene_from_json(reference_cantilever(4));
+  const int tip = body_index(model, "tip");
+  TransientOptions tight = options(0.05, 1e-3, 1e-12, 1e-13);
+  tight.integrator.method = "erk";
+  tight.integrator.table = "VERNER_8_5_6";
+  const TransientRun reference = simulate(model, tight);
+  ASSERT_TRUE(reference.result.ok);
+  double previous = 0.0;
+  double lowest_order = 10.0;
+  for (double h : {1e-3, 5e-4, 2.5e-4, 1.25e-4}) {
+    TransientOptions o = modal(0.05, 1e-3, 1e3, 1e3);
+    o.integrator.max_step = h;
+    o.integrator.initial_step = h;
+    const TransientRun run = simulate(model, o);
+    ASSERT_TRUE(run.result.ok) << run.result.message;
+    const double e = body_error(run, reference, tip);
+    if (previous > 0.0) {
+      const double order = std::log2(previous / e);
+      lowest_order = std::min(lowest_order, order);
+      std::printf("h %.3e: error %.3e, observed order %.2f\n", h, e, order);
+    } else {
+      std::printf("h %.3e: error %.3e\n", h, e);
+    }
+    previous = e;
+  }
+  // Order 4 for smooth nonlinearities; the rotation of the beams' stiffness with the (small)
+  // deflection couples the fast modes into the nonlinear part, and the observed order drops.
+  EXPECT_GT(lowest_order, 2.0);
+}
+
+TEST(ModalIntegrator, RefusesScenesAboveItsSizeLimit) {
+  const int too_many = kModalIntegratorMaxDofs / kDofsPerBody + 1;
+  const Model model = scene_from_json(reference_cantilever(too_many));
+  ASSERT_GT(model.n_dofs, kModalIntegratorMaxDofs);
+  const TransientRun run = simulate(model, modal(1e-3, 1e-3, 1e-6, 1e-9));
+  EXPECT_FALSE(run.result.ok);
+  EXPECT_NE(run.result.message.find("up to 200 free bodies"), std::string::npos)
+      << run.result.message;
+  EXPECT_TRUE(run.samples.empty());
+}
+
+TEST(ModalIntegrator, StopsWithAMessageWhenABodyTurnsTooFar) {
+  // A free body spinning at 2.2 rad/s about z passes 1 rad after 0.45 s.
+  const Model model = scene_from_json(R"({
+    "bodies": [{"name": "spinner", "position": [0, 0, 0], "mass": 1.0,
+                "inertia": [0.1, 0.1, 0.2], "angular_velocity": [0, 0, 2.2]}]})");
+  const TransientRun run = simulate(model, modal(1.0, 0.1, 1e-8, 1e-10));
+  EXPECT_FALSE(run.result.ok);
+  EXPECT_NE(run.result.message.find("\"spinner\" turned more than"), std::string::npos)
+      << run.result.message;
+  // The samples up to 0.4 s (0.88 rad) are delivered and exact: a free rotation about a
+  // principal axis is the closed form angle = 2.2 t.
+  ASSERT_EQ(run.samples.size(), 5u);
+  const int b = body_index(model, "spinner");
+  for (const auto& s : run.samples)
+    EXPECT_NEAR(rotation_vector(s.pose[b].A).z(), 2.2 * s.sample.t, 1e-12) << s.sample.t;
+  EXPECT_NEAR(run.result.t_reached, 0.4, 1e-12);
+}
+
+}  // namespace
+}  // namespace beamrail

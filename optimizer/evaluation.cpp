@@ -56,7 +56,9 @@ class Runner {
     report.type = "static";
     if (!static_result_) {
       static_options_ = options;
-      static_result_ = solve_static(model_, options, static_data_);
+      static_options_.structure_cache =
+          options_.structure_cache ? options_.structure_cache : &structures_;
+      static_result_ = solve_static(model_, static_options_, static_data_);
     }
     const StaticResult& r = *static_result_;
     report.ok = r.ok;

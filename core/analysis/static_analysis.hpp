@@ -1,13 +1,15 @@
 // Static analysis (DESIGN.md §2): equilibrium of all free bodies under gravity and the loads at a
 // given time, geometrically nonlinear. Newton's method on 6 unknowns per free body (centre
-// displacement and rotation increment) with the exact tangent by automatic differentiation, a
-// backtracking line search, and automatic load stepping when a full step fails.
+// displacement and rotation increment) with the exact tangent by automatic differentiation
+// (factored by KLU with the topology's shared symbolic analysis), a backtracking line search, and
+// automatic load stepping when a full step fails.
 #pragma once
 
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "core/analysis/sparse_structure.hpp"
 #include "core/model/data.hpp"
 #include "core/model/model.hpp"
 
@@ -20,6 +22,9 @@ struct StaticOptions {
   int max_iterations = 30;    // Newton iterations per load step
   double tolerance = 1e-10;   // residual, relative to the applied load scale
   int max_load_steps = 1000;  // total load increments allowed (including subdivisions)
+  // Shares the tangent's sparse pattern and KLU ordering between analyses of one topology
+  // (designs); nullptr: this analysis makes its own.
+  SparseStructureCache* structure_cache = nullptr;
 };
 
 struct StaticResult {

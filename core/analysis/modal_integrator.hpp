@@ -11,8 +11,9 @@
 // a being the exact accelerations (dv/dt, domega/dt) of the equations of motion. Each mode's
 // linear part [[0, 1], [-lambda, 0]] is integrated exactly (phi functions of 2 x 2 blocks); the
 // rest (nonlinearity, load changes, damping, the non-symmetric part) by the stiff-order-4
-// exponential Runge-Kutta method of Hochbruck and Ostermann (2005). Steps are controlled by step
-// doubling (error of the two half steps, Richardson estimate), measured in the physical states.
+// exponential Runge-Kutta method of Hochbruck and Ostermann (2005). Steps are controlled by the
+// distance to an embedded second-order solution from the same stages, measured in the physical
+// states; the fourth-order solution is kept.
 //
 // Cost: one dense eigenproblem (n_dofs^3) at set-up, then two dense n_dofs x n_dofs products per
 // stage; hence a size limit. Accuracy degrades with the size of the motion: past kMaxRotation the

@@ -221,14 +221,16 @@ class ModalExponential : public Integrator {
     z_ = psi_t_ * x;
   }
 
-  // Physical coordinates x = Phi z into the 13 states; false when a body turned too far.
-  bool states_of(const Block& x, double* y) {
+  // Physical coordinates x = Phi z into the 13 states; false (with far_body_ set) when a body
+  // turned too far and `check`; all bodies are written either way.
+  bool states_of(const Block& x, double* y, bool check = true) {
+    bool within = true;
     for (size_t b = 0; b < c0_.size(); ++b) {
       double* s = y + kS * b;
       const Vec3 theta = x.block<3, 1>(kD * b + 3, 0);
-      if (!(theta.norm() <= kModalIntegratorMaxRotation)) {
+      if (check && within && !(theta.norm() <= kModalIntegratorMaxRotation)) {
         far_body_ = static_cast<int>(b);
-        return false;
+        within = false;
       }
       Vec4 q = quat_multiply(quat_from_rotation_vector(theta), q0_[b]);
       q /= q.norm();
@@ -242,13 +244,11 @@ class ModalExponential : public Integrator {
       }
       for (int j = 0; j < 4; ++j) s[3 + j] = q(j);
     }
-    return true;
+    return within;
   }
 
-  void to_states(double* y) {
-    const Block x = phi_ * z_;
-    if (!states_of(x, y)) far_body_ = -1;  // reported by the step that went there
-  }
+  // The accepted state (a rotation past the limit is reported by the next step that uses it).
+  void to_states(double* y) { states_of(phi_ * z_, y, false); }
 
   // N(t, z): everything but the modes' linear part, in modal coordinates. False when the forces
   // are not finite or a body turned too far.

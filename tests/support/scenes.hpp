@@ -19,4 +19,12 @@ inline Model scene_from_json(const std::string& text) {
   return *model;
 }
 
+// The index of the body called `name`; a missing body fails the test (and gives 0).
+inline int body_index(const Model& model, const std::string& name) {
+  for (size_t i = 0; i < model.bodies.size(); ++i)
+    if (model.bodies[i].name == name) return static_cast<int>(i);
+  ADD_FAILURE() << "no body " << name;
+  return 0;
+}
+
 }  // namespace beamrail::testing

@@ -1,6 +1,7 @@
 // Runs a transient analysis on a scene and keeps every sample (energies and body states).
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "core/analysis/transient.hpp"
@@ -27,6 +28,18 @@ inline TransientRun simulate(const Model& model, const TransientOptions& options
     r.samples.push_back({s, d.pose, d.q, d.w});
   });
   return r;
+}
+
+// Largest distance of body b's centre from its reference position over the common samples,
+// relative to its largest motion in the reference.
+inline double motion_error(const TransientRun& run, const TransientRun& reference, int b) {
+  double error = 0.0, motion = 0.0;
+  const Vec3 start = reference.samples.front().pose[b].c;
+  for (const auto& s : reference.samples) motion = std::max(motion, (s.pose[b].c - start).norm());
+  const size_t n = std::min(run.samples.size(), reference.samples.size());
+  for (size_t k = 0; k < n; ++k)
+    error = std::max(error, (run.samples[k].pose[b].c - reference.samples[k].pose[b].c).norm());
+  return error / motion;
 }
 
 inline TransientOptions options(double t_end, double output_step, double rtol, double atol) {

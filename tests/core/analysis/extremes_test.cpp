@@ -86,12 +86,7 @@ struct Scene {
   Model model() const { return testing::scene_from_json(j.dump()); }
 };
 
-int body_index(const Model& model, const std::string& name) {
-  for (size_t i = 0; i < model.bodies.size(); ++i)
-    if (model.bodies[i].name == name) return static_cast<int>(i);
-  ADD_FAILURE() << "no body " << name;
-  return 0;
-}
+using testing::body_index;
 
 struct Equilibrium {
   StaticResult result;

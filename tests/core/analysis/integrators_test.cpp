@@ -1,7 +1,8 @@
-// The integrator families (CVODE bdf/adams, ARKODE dirk/erk, the modal exponential method), the linear solvers (dense, sparse
-// KLU) and the Jacobian kinds (exact, finite differences) must all integrate the same motion: each
-// is compared with a tight reference run on a segmented cantilever hit by a step load. Also: the
-// automatic choice of the linear solver, and the wall-clock budget ending a run as a timeout.
+// The integrator families (CVODE bdf/adams, ARKODE dirk/erk, the modal exponential method), the
+// linear solvers (dense, sparse KLU) and the Jacobian kinds (exact, finite differences) must all
+// integrate the same motion: each is compared with a tight reference run on a segmented cantilever
+// hit by a step load. Also: the automatic choice of the linear solver, and the wall-clock budget
+// ending a run as a timeout.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,30 +15,14 @@
 namespace beamrail {
 namespace {
 
+using testing::body_index;
+using testing::motion_error;
 using testing::options;
 using testing::scene_from_json;
 using testing::simulate;
 using testing::TransientRun;
 
 using testing::reference_cantilever;
-
-// Largest distance of the tip body from its reference position over the common samples,
-// relative to the largest tip motion in the reference.
-double tip_error(const TransientRun& run, const TransientRun& reference, int tip) {
-  double error = 0.0, motion = 0.0;
-  const Vec3 start = reference.samples.front().pose[tip].c;
-  for (const auto& s : reference.samples) motion = std::max(motion, (s.pose[tip].c - start).norm());
-  const size_t n = std::min(run.samples.size(), reference.samples.size());
-  for (size_t k = 0; k < n; ++k)
-    error = std::max(error, (run.samples[k].pose[tip].c - reference.samples[k].pose[tip].c).norm());
-  return error / motion;
-}
-
-int body_index(const Model& model, const std::string& name) {
-  for (size_t i = 0; i < model.bodies.size(); ++i)
-    if (model.bodies[i].name == name) return static_cast<int>(i);
-  return -1;
-}
 
 struct Family {
   const char* label;
@@ -81,7 +66,7 @@ TEST(Integrators, EveryFamilyIntegratesTheSameMotion) {
     const TransientRun run = simulate(model, o);
     ASSERT_TRUE(run.result.ok) << f.label << ": " << run.result.message;
     ASSERT_EQ(run.samples.size(), reference.samples.size()) << f.label;
-    const double e = tip_error(run, reference, tip);
+    const double e = motion_error(run, reference, tip);
     std::printf("%-16s error %.2e  steps %6ld  rhs %7ld  jac %5ld  solver %s\n", f.label, e,
                 run.result.stats.steps, run.result.stats.rhs_evaluations,
                 run.result.stats.jacobian_evaluations, run.result.linear_solver.c_str());
@@ -119,10 +104,9 @@ TEST(Integrators, DenseAndSparseSolversGiveTheSameRun) {
   // 6 bodies: 78 states; each body's 13x13 block couples only to its chain neighbours.
   EXPECT_GT(sparse.result.jacobian_nonzeros, 0);
   EXPECT_LT(sparse.result.jacobian_nonzeros, 78 * 78 / 2);
-  const double e = tip_error(sparse, dense, tip);
+  const double e = motion_error(sparse, dense, tip);
   std::printf("dense vs sparse: %.2e relative, steps %ld vs %ld, nonzeros %ld\n", e,
-              dense.result.stats.steps, sparse.result.stats.steps,
-              sparse.result.jacobian_nonzeros);
+              dense.result.stats.steps, sparse.result.stats.steps, sparse.result.jacobian_nonzeros);
   // Both runs meet the same tolerances; rounding differences in the factorizations can change
   // step sizes, so they agree to the integration accuracy (rtol 1e-7 on positions of about 1 m
   // against a motion of about 1e-4 m), not bitwise.

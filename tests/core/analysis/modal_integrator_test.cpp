@@ -15,29 +15,13 @@
 namespace beamrail {
 namespace {
 
+using testing::body_index;
+using testing::motion_error;
 using testing::options;
 using testing::reference_cantilever;
 using testing::scene_from_json;
 using testing::simulate;
 using testing::TransientRun;
-
-// Largest distance of body `b` from its reference position relative to its largest motion.
-double body_error(const TransientRun& run, const TransientRun& reference, int b) {
-  double error = 0.0, motion = 0.0;
-  const Vec3 start = reference.samples.front().pose[b].c;
-  for (const auto& s : reference.samples) motion = std::max(motion, (s.pose[b].c - start).norm());
-  EXPECT_EQ(run.samples.size(), reference.samples.size());
-  const size_t n = std::min(run.samples.size(), reference.samples.size());
-  for (size_t k = 0; k < n; ++k)
-    error = std::max(error, (run.samples[k].pose[b].c - reference.samples[k].pose[b].c).norm());
-  return error / motion;
-}
-
-int body_index(const Model& model, const std::string& name) {
-  for (size_t i = 0; i < model.bodies.size(); ++i)
-    if (model.bodies[i].name == name) return static_cast<int>(i);
-  return -1;
-}
 
 TransientOptions modal(double t_end, double output_step, double rtol, double atol) {
   TransientOptions o = options(t_end, output_step, rtol, atol);
@@ -151,7 +135,8 @@ TEST(ModalIntegrator, AgreesWithATightReference) {
     for (double rtol : {1e-6, 1e-7}) {
       const TransientRun run = simulate(model, modal(0.05, 5e-4, rtol, 1e-2 * rtol));
       ASSERT_TRUE(run.result.ok) << c.label << ": " << run.result.message;
-      const double e = body_error(run, reference, tip);
+      ASSERT_EQ(run.samples.size(), reference.samples.size()) << c.label;
+      const double e = motion_error(run, reference, tip);
       // Largest angle between the tip body's orientations.
       double angle = 0.0;
       for (size_t k = 0; k < run.samples.size(); ++k) {
@@ -183,7 +168,8 @@ TEST(ModalIntegrator, RestartsAtLoadBreakpoints) {
   const TransientRun reference = simulate(model, tight);
   const TransientRun run = simulate(model, modal(0.04, 5e-4, 1e-7, 1e-9));
   ASSERT_TRUE(reference.result.ok && run.result.ok) << run.result.message;
-  const double e = body_error(run, reference, tip);
+  ASSERT_EQ(run.samples.size(), reference.samples.size());
+  const double e = motion_error(run, reference, tip);
   std::printf("pulse with two breakpoints: tip error %.2e, steps %ld\n", e, run.result.stats.steps);
   EXPECT_LT(e, 1e-7);
 }
@@ -206,7 +192,8 @@ TEST(ModalIntegrator, ObservedOrderOfConvergence) {
     o.integrator.initial_step = h;
     const TransientRun run = simulate(model, o);
     ASSERT_TRUE(run.result.ok) << run.result.message;
-    const double e = body_error(run, reference, tip);
+    ASSERT_EQ(run.samples.size(), reference.samples.size());
+    const double e = motion_error(run, reference, tip);
     if (previous > 0.0) {
       const double order = std::log2(previous / e);
       lowest_order = std::min(lowest_order, order);

@@ -17,7 +17,8 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
                      IntegratorOptions& io) {
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return;
-  if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk", "modal"})) io.method = *m;
+  if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk", "modal"}))
+    io.method = *m;
   if (const auto t = r.string("table", false)) {
     if (io.method != "dirk" && io.method != "erk")
       r.error("table", "a Butcher table applies to the \"dirk\" and \"erk\" methods");
@@ -143,8 +144,8 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   a.where = where;
   const auto type = r.choice("type", true, kAnalysisTypes);
   if (!type) {
-    r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "time", "load_steps", "tolerance",
-             "max_iterations", "modes", "about", "solver"});
+    r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "time", "load_steps",
+             "tolerance", "max_iterations", "modes", "about", "solver"});
     return std::nullopt;
   }
   bool ok = false;

@@ -51,7 +51,8 @@ void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>
     // Copies: adding the interior bodies below may reallocate specs.bodies.
     const BodySpec b1 = specs.bodies[e.body1];
     const BodySpec b2 = specs.bodies[e.body2];
-    const Mat3 a1 = rotation_matrix<double>(b1.orientation), a2 = rotation_matrix<double>(b2.orientation);
+    const Mat3 a1 = rotation_matrix<double>(b1.orientation),
+               a2 = rotation_matrix<double>(b2.orientation);
     const Vec3 om1 = a1 * b1.angular_velocity, om2 = a2 * b2.angular_velocity;
     int previous = e.body1;
     for (long k = 1; k <= n; ++k) {
@@ -94,7 +95,8 @@ Vec3 combine_masses(const BodySpec& b, const std::vector<PointMass>& extra, doub
                     Mat3* inertia) {
   const Mat3 a = rotation_matrix<double>(b.orientation);
   std::vector<PointMass> parts = extra;
-  if (b.mass) parts.push_back({*b.mass, b.position, a * b.inertia.value_or(Mat3::Zero()) * a.transpose()});
+  if (b.mass)
+    parts.push_back({*b.mass, b.position, a * b.inertia.value_or(Mat3::Zero()) * a.transpose()});
   double m = 0.0;
   Vec3 first = Vec3::Zero();
   for (const PointMass& p : parts) m += p.mass, first += p.mass * p.point;
@@ -142,7 +144,8 @@ ElementEnds make_ends(const ElementSpec& e, const std::vector<Body>& bodies) {
   const Mat3 frame = *element_frame(e.p1, e.p2, e.p3, e.where, unused);
   const Body& b1 = bodies[e.body1];
   const Body& b2 = bodies[e.body2];
-  const Mat3 a1 = rotation_matrix<double>(b1.orientation), a2 = rotation_matrix<double>(b2.orientation);
+  const Mat3 a1 = rotation_matrix<double>(b1.orientation),
+             a2 = rotation_matrix<double>(b2.orientation);
   ends.r1 = a1.transpose() * (e.p1 - b1.position);
   ends.r2 = a2.transpose() * (e.p2 - b2.position);
   ends.frame1 = a1.transpose() * frame;
@@ -278,7 +281,8 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
   for (size_t k = 0; k < specs.loads.size(); ++k) {
     Load load = specs.loads[k];
     const Body& b = model.bodies[load.body];
-    load.offset = rotation_matrix<double>(b.orientation).transpose() * (specs.load_points[k] - b.position);
+    load.offset =
+        rotation_matrix<double>(b.orientation).transpose() * (specs.load_points[k] - b.position);
     // Every load was accepted, so k is its index in the scene.
     if (!load.offset.allFinite()) {
       diag.error(where.file, (where / "loads" / k / "point").pointer,
@@ -292,8 +296,9 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
 
   model.finalize();
   if (model.n_free() == 0) {
-    diag.error(where.file, (where / "bodies").pointer,
-               "the scene has no free body: nothing can move (every body is fixed or none is given)");
+    diag.error(
+        where.file, (where / "bodies").pointer,
+        "the scene has no free body: nothing can move (every body is fixed or none is given)");
     return std::nullopt;
   }
   return model;

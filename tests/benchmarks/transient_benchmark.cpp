@@ -89,19 +89,39 @@ void ReferenceProblem(benchmark::State& state, const char* method, const char* t
   state.counters["ok"] = result.ok;
 }
 BENCHMARK_CAPTURE(ReferenceProblem, dirk_esdirk547_rtol1e_5, "dirk", "ESDIRK547L2SA2_7_4_5", 1e-5)
-    ->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(ReferenceProblem, dirk_esdirk547_rtol3e_5, "dirk", "ESDIRK547L2SA2_7_4_5", 3e-5)
-    ->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(ReferenceProblem, erk_verner_rtol1e_4, "erk", "VERNER_8_5_6", 1e-4)
-    ->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(ReferenceProblem, modal_rtol5e_5, "modal", "", 5e-5)
-    ->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(ReferenceProblem, modal_rtol1e_4, "modal", "", 1e-4)
-    ->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(ReferenceProblem, modal_rtol1e_5, "modal", "", 1e-5)
-    ->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(ReferenceProblem, bdf_rtol1e_6, "bdf", "", 1e-6)
-    ->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(1);
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 // Wall time per step of a chain of N bodies: the reference cantilever in N segments under its step
 // load, BDF with the sparse (KLU) solver, stopped after a fixed budget of 300 steps (set-up
@@ -132,7 +152,12 @@ void TransientStep(benchmark::State& state) {
       benchmark::Counter(steps, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(TransientStep)
-    ->Arg(100)->Arg(300)->Arg(1000)->Arg(3000)->Arg(10000)->Unit(benchmark::kMillisecond);
+    ->Arg(100)
+    ->Arg(300)
+    ->Arg(1000)
+    ->Arg(3000)
+    ->Arg(10000)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace beamrail

@@ -50,6 +50,7 @@ struct ModeFunction {
   Eigen::ArrayXd alpha, beta;
   ModeFunction() = default;
   explicit ModeFunction(Eigen::Index n) : alpha(Eigen::ArrayXd::Zero(n)), beta(alpha) {}
+  bool empty() const { return alpha.size() == 0; }  // a zero coefficient: skipped
   ModeFunction& add(double s, const ModeFunction& f) {
     alpha += s * f.alpha;
     beta += s * f.beta;
@@ -81,7 +82,6 @@ struct StepFunctions {
   ModeFunction a[kStages][kStages];
   ModeFunction b[kStages];
   ModeFunction low[2];  // the embedded order-2 method: b1 = phi1 - 2 phi2, b2 = 2 phi2
-  bool used(int i, int j) const { return a[i][j].alpha.size() > 0; }
 
   void compute(double step, const Eigen::ArrayXd& lambda) {
     h = step;
@@ -290,7 +290,7 @@ class ModalExponential : public Integrator {
       Block zi = Block::Zero(n_, 2);
       apply_add(StepFunctions::c[i] == 1.0 ? f.e_full : f.e_half, lambda_, z, zi);
       for (int j = 0; j < i; ++j) {
-        if (!f.used(i, j)) continue;
+        if (f.a[i][j].empty()) continue;
         apply_add(f.a[i][j], lambda_, f.h * stage_n_[j], zi);
       }
       stage_n_[i].resize(n_, 2);
@@ -299,7 +299,7 @@ class ModalExponential : public Integrator {
     out = Block::Zero(n_, 2);
     apply_add(f.e_full, lambda_, z, out);
     for (int j = 0; j < s; ++j)
-      if (f.b[j].alpha.size() > 0) apply_add(f.b[j], lambda_, f.h * stage_n_[j], out);
+      if (!f.b[j].empty()) apply_add(f.b[j], lambda_, f.h * stage_n_[j], out);
     return true;
   }
 

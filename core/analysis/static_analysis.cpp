@@ -76,10 +76,12 @@ class TangentSolver {
     if (!structure_) return factorize_dense();
     const JacobianPattern& p = structure_->reduced();
     values_.assign(p.rows.size(), 0.0);
+    static_assert(kVelocityStates == kDofsPerBody, "the tangent's blocks are the pattern's");
+    constexpr int n = kVelocityStates;
     for (size_t b = 0; b < data.stiffness.size(); ++b)
-      for (int r = 0; r < kDofsPerBody; ++r)
-        for (int c = 0; c < kDofsPerBody; ++c)
-          values_[p.positions[b * 36 + 6 * r + c]] = data.stiffness[b](r, c);
+      for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c)
+          values_[p.positions[b * n * n + n * r + c]] = data.stiffness[b](r, c);
     free_numeric();
     numeric_ =
         klu_l_factor(const_cast<long*>(p.column_starts.data()), const_cast<long*>(p.rows.data()),

@@ -87,6 +87,79 @@ TEST(Rotation, RotationVectorRateMatchesFiniteDifferences) {
             1e-17);
 }
 
+TEST(Rotation, AngularVelocityInvertsTheRotationVectorRate) {
+  // theta(t) = theta0 + v t: [omega]x = dA/dt A^T by central differences, and the round trip
+  // through rotation_vector_rate, from the series branch to 2.8 rad.
+  testing::Random rng(6);
+  double worst_fd = 0.0, worst_trip = 0.0;
+  for (double angle : {1e-3, 0.05, 0.1, 0.3, 1.0, 2.0, 2.8}) {
+    for (int i = 0; i < 20; ++i) {
+      const Vec3 theta = angle * rng.vec3(1.0).normalized(), v = rng.vec3(1.0);
+      const double h = 1e-6;
+      const auto at = [&](double t) {
+        return rotation_matrix<double>(quat_from_rotation_vector(theta + v * t));
+      };
+      const Mat3 w = (at(h) - at(-h)) / (2 * h) * at(0).transpose();
+      const Vec3 omega = angular_velocity(theta, v);
+      const double fd = (Vec3(w(2, 1), w(0, 2), w(1, 0)) - omega).norm() / v.norm();
+      const double trip = (rotation_vector_rate(theta, omega) - v).norm() / v.norm();
+      worst_fd = std::max(worst_fd, fd);
+      worst_trip = std::max(worst_trip, trip);
+      EXPECT_LT(fd, 1e-8) << "angle " << angle;
+      EXPECT_LT(trip, 1e-14) << "angle " << angle;
+    }
+  }
+  std::printf("angular_velocity: vs finite differences %.2e, round trip %.2e (relative)\n",
+              worst_fd, worst_trip);
+}
+
+TEST(Rotation, InverseJacobianCoefficientDerivativeMatchesDifferences) {
+  // dc/ds against central differences of c, across the switch from the series at s = 1/4; c
+  // continuous there.
+  double worst = 0.0;
+  for (double s : {1e-8, 1e-3, 0.1, 0.2499, 0.2501, 0.5, 2.0, 6.0}) {
+    double c, d, cp, cm, unused;
+    rotation_detail::inverse_jacobian_coefficient(s, &c, &d);
+    const double h = 1e-4 * std::max(s, 1e-2);
+    rotation_detail::inverse_jacobian_coefficient(s + h, &cp, &unused);
+    rotation_detail::inverse_jacobian_coefficient(s - h, &cm, &unused);
+    worst = std::max(worst, std::abs((cp - cm) / (2 * h) - d) / d);
+    EXPECT_NEAR((cp - cm) / (2 * h), d, 1e-7 * d) << "s " << s;
+  }
+  double below, above, d_below, d_above;
+  rotation_detail::inverse_jacobian_coefficient(std::nextafter(0.25, 0.0), &below, &d_below);
+  rotation_detail::inverse_jacobian_coefficient(0.25, &above, &d_above);
+  EXPECT_NEAR(below, above, 1e-15);
+  EXPECT_NEAR(d_below, d_above, 1e-12 * d_above);
+  std::printf(
+      "dc/ds vs differences: worst relative %.2e; at the switch c %.17g / %.17g, dc/ds %.17g / "
+      "%.17g\n",
+      worst, below, above, d_below, d_above);
+}
+
+TEST(Rotation, RotationVectorAccelerationMatchesDifferences) {
+  // theta(t) = theta0 + v t + alpha t^2 / 2: domega/dt of omega(t) = J(theta) dtheta/dt by central
+  // differences; rotation_vector_acceleration must give alpha back.
+  testing::Random rng(7);
+  double worst = 0.0;
+  for (double angle : {0.0, 1e-3, 0.1, 0.45, 0.55, 1.0, 2.5}) {
+    for (int i = 0; i < 20; ++i) {
+      const Vec3 theta = angle * rng.vec3(1.0).normalized(), v = rng.vec3(1.0),
+                 alpha = rng.vec3(1.0);
+      const auto omega = [&](double t) {
+        return angular_velocity(theta + v * t + 0.5 * alpha * t * t, v + alpha * t);
+      };
+      const double h = 1e-4;
+      const Vec3 omega_rate = (omega(h) - omega(-h)) / (2 * h);
+      const double e =
+          (rotation_vector_acceleration(theta, v, omega_rate) - alpha).norm() / alpha.norm();
+      worst = std::max(worst, e);
+      EXPECT_LT(e, 1e-7) << "angle " << angle;
+    }
+  }
+  std::printf("rotation_vector_acceleration vs differences: worst relative %.2e\n", worst);
+}
+
 TEST(Rotation, QuaternionProductMatrices) {
   testing::Random rng(4);
   const Vec4 q(0.3, -0.5, 0.7, 0.1);

@@ -52,6 +52,12 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   io.max_step = r.positive("max_step", false).value_or(0.0);
   io.initial_step = r.positive("initial_step", false).value_or(0.0);
   io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
+  if (const auto about = r.choice("about", false, {"static", "initial"})) {
+    if (io.method != "modal")
+      r.error("about", "applies to the \"modal\" method");
+    else
+      io.about = *about;
+  }
 }
 
 namespace {

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/analysis/ode_system.hpp"
 #include "core/analysis/sundials_support.hpp"
@@ -25,7 +26,8 @@ class Integrator {
   virtual std::string failure(int flag) const = 0;
   // "dense", "sparse" or "none" (explicit methods).
   std::string linear_solver = "none";
-  long nnz = 0;  // stored Jacobian entries (sparse)
+  long nnz = 0;                       // stored Jacobian entries (sparse)
+  std::vector<std::string> warnings;  // for the run's result (set up at construction)
 };
 
 // Builds the integrator of options.method for the system in `context`, starting at (0, y0).

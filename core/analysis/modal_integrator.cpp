@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 
+#include "core/analysis/dense_product.hpp"
 #include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/static_analysis.hpp"
 #include "core/model/dynamics.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
@@ -13,20 +16,43 @@
 
 namespace beamrail {
 
+namespace {
+
+// The Taylor coefficients (-1)^j / (2j + m)! of g_m, j = 0..kTerms-1: at |x| < 4 the next term
+// is below 1e-22 of the first.
+constexpr int kTerms = 13;
+template <int m>
+constexpr std::array<double, kTerms> oscillator_coefficients() {
+  std::array<double, kTerms> c{};
+  double f = 1.0;  // (2j + m)!
+  for (int i = 2; i <= m; ++i) f *= i;
+  for (int j = 0; j < kTerms; ++j) {
+    c[j] = (j % 2 ? -1.0 : 1.0) / f;
+    f *= (2.0 * j + m + 1) * (2.0 * j + m + 2);
+  }
+  return c;
+}
+
+template <int m>
+double oscillator_series(double x) {
+  static constexpr std::array<double, kTerms> c = oscillator_coefficients<m>();
+  double sum = c[kTerms - 1];
+  for (int j = kTerms - 2; j >= 0; --j) sum = sum * x + c[j];
+  return sum;
+}
+
+}  // namespace
+
 std::array<double, 5> oscillator_g(double x) {
   std::array<double, 5> g{};
   if (std::abs(x) < 4.0) {
-    // Power series: |x|^j / (2j + m)! falls below 1e-17 of the first term by j = 14.
-    for (int m = 0; m < 5; ++m) {
-      double fact = 1.0;  // m!
-      for (int i = 2; i <= m; ++i) fact *= i;
-      double term = 1.0 / fact, sum = term;
-      for (int j = 1; j < 16; ++j) {
-        term *= -x / ((2.0 * j + m - 1) * (2.0 * j + m));
-        sum += term;
-      }
-      g[m] = sum;
-    }
+    // Series for g3 and g4, then g_m = 1/m! - x g_{m+2} down to g0 (for 0 < x < 4 the subtraction
+    // loses at most a factor 3, at g0 = cos 2).
+    g[4] = oscillator_series<4>(x);
+    g[3] = oscillator_series<3>(x);
+    g[2] = 0.5 - x * g[4];
+    g[1] = 1.0 - x * g[3];
+    g[0] = 1.0 - x * g[2];
     return g;
   }
   const double s = std::sqrt(std::abs(x));
@@ -44,6 +70,12 @@ constexpr int kD = kDofsPerBody;
 constexpr int kS = kStatesPerBody;
 
 using Block = Eigen::Matrix<double, Eigen::Dynamic, 2>;  // per mode: (eta, nu) or (x, u) columns
+
+// out = a b (a change of basis of both columns).
+void multiply(const Eigen::MatrixXd& a, const Block& b, Block& out) {
+  out.resize(a.rows(), 2);
+  multiply_pair(a, b.data(), out.data());
+}
 
 // A function of the mode blocks B_i = [[0, 1], [-lambda_i, 0]], f(B_i) = alpha_i I + beta_i B_i.
 struct ModeFunction {
@@ -123,6 +155,13 @@ struct StepFunctions {
   }
 };
 
+// "1 rad" for messages.
+std::string rotation_limit_text() {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g rad", kModalIntegratorMaxRotation);
+  return text;
+}
+
 enum Flag { kOk = 0, kTooManySteps = -1, kStepTooSmall = -3, kNonFinite = -8, kTooFar = -20 };
 
 class ModalExponential : public Integrator {
@@ -139,11 +178,14 @@ class ModalExponential : public Integrator {
                              std::to_string(model.n_free()) +
                              " here): use bdf or dirk with the sparse solver");
     y13_.resize(model.n_states);
+    acceleration_.resize(n_);
     ydot13_.resize(model.n_states);
     const double* y = N_VGetArrayPointer(y0);
-    // The linearization: mass and symmetric tangent stiffness at the initial pose, at rest.
+    std::vector<double> reference(y, y + model.n_states);
+    if (!choose_reference(model, reference, error)) return false;
+    // The linearization: mass and symmetric tangent stiffness at the reference, at rest.
     Data& data = c.data;
-    set_state(model, data, y);
+    set_state(model, data, reference.data());
     compute_wrenches(model, data, 0.0);
     compute_tangent(model, data, 0.0, false);
     const Eigen::MatrixXd k = -Eigen::MatrixXd(stiffness_matrix(model, data));
@@ -157,8 +199,9 @@ class ModalExponential : public Integrator {
     a0_.resize(model.n_free());
     q0_.resize(model.n_free());
     for (int b = 0; b < model.n_free(); ++b) {
-      c0_[b] = Vec3(y[kS * b], y[kS * b + 1], y[kS * b + 2]);
-      q0_[b] = Vec4(y[kS * b + 3], y[kS * b + 4], y[kS * b + 5], y[kS * b + 6]).normalized();
+      const double* r = reference.data() + kS * b;
+      c0_[b] = Vec3(r[0], r[1], r[2]);
+      q0_[b] = Vec4(r[3], r[4], r[5], r[6]).normalized();
       a0_[b] = rotation_matrix<double>(q0_[b]);
     }
     from_states(y);
@@ -207,6 +250,46 @@ class ModalExponential : public Integrator {
     return false;
   }
 
+  // The state linearized about (options_.about), written over `reference` (which holds the
+  // initial state): the static equilibrium under the loads at t = 0, at rest, or the initial
+  // state. False (with *error) when "static" was asked for and no equilibrium was found.
+  bool choose_reference(const Model& model, std::vector<double>& reference, std::string* error) {
+    if (options_.about == "initial") return true;
+    Data data(model);
+    set_state(model, data, reference.data());
+    StaticOptions statics;
+    statics.time = 0.0;
+    const StaticResult equilibrium = solve_static(model, statics, data);
+    std::string why;
+    if (!equilibrium.ok) {
+      why = "no static equilibrium under the loads at t = 0 (" + equilibrium.message + ")";
+    } else {
+      for (int b = 0; b < model.n_free() && why.empty(); ++b) {
+        const int body = model.free_bodies[b];
+        const double* r = reference.data() + kS * b;
+        const Mat3 a0 = rotation_matrix<double>(Vec4(r[3], r[4], r[5], r[6]));
+        if (rotation_vector(data.pose[body].A * a0.transpose()).norm() >
+            kModalIntegratorMaxRotation)
+          why = "in the static equilibrium under the loads at t = 0, body \"" +
+                model.bodies[body].name + "\" is turned more than " + rotation_limit_text() +
+                " from its initial orientation";
+      }
+    }
+    if (!why.empty()) {
+      if (options_.about == "static") return fail(error, "the modal integrator: " + why);
+      warnings.push_back("the modal integrator linearized about the initial state: " + why);
+      return true;
+    }
+    for (int b = 0; b < model.n_free(); ++b) {
+      const int body = model.free_bodies[b];
+      double* r = reference.data() + kS * b;
+      for (int j = 0; j < 3; ++j) r[j] = data.pose[body].c(j);
+      for (int j = 0; j < 4; ++j) r[3 + j] = data.q[body](j);
+      for (int j = 7; j < kS; ++j) r[j] = 0.0;
+    }
+    return true;
+  }
+
   // z from the 13 states of every free body.
   void from_states(const double* y) {
     Block x(n_, 2);
@@ -216,9 +299,11 @@ class ModalExponential : public Integrator {
       x.block<3, 1>(kD * b, 0) = Vec3(s[0], s[1], s[2]) - c0_[b];
       x.block<3, 1>(kD * b + 3, 0) = rotation_vector(a * a0_[b].transpose());
       x.block<3, 1>(kD * b, 1) = Vec3(s[7], s[8], s[9]);
-      x.block<3, 1>(kD * b + 3, 1) = a * Vec3(s[10], s[11], s[12]);
+      x.block<3, 1>(kD * b + 3, 1) =
+          rotation_vector_rate(x.block<3, 1>(kD * b + 3, 0), a * Vec3(s[10], s[11], s[12]));
     }
-    z_ = psi_t_ * x;
+    multiply(psi_t_, x, z_);
+    multiply(phi_, z_, x_);
   }
 
   // Physical coordinates x = Phi z into the 13 states; false (with far_body_ set) when a body
@@ -236,7 +321,7 @@ class ModalExponential : public Integrator {
       q /= q.norm();
       const Mat3 a = rotation_matrix<double>(q);
       const Vec3 c = c0_[b] + x.block<3, 1>(kD * b, 0);
-      const Vec3 w = a.transpose() * x.block<3, 1>(kD * b + 3, 1);
+      const Vec3 w = a.transpose() * angular_velocity(theta, x.block<3, 1>(kD * b + 3, 1));
       for (int j = 0; j < 3; ++j) {
         s[j] = c(j);
         s[7 + j] = x(kD * b + j, 1);
@@ -248,19 +333,18 @@ class ModalExponential : public Integrator {
   }
 
   // The accepted state (a rotation past the limit is reported by the next step that uses it).
-  void to_states(double* y) { states_of(phi_ * z_, y, false); }
+  void to_states(double* y) { states_of(x_, y, false); }
 
-  // N(t, z): everything but the modes' linear part, in modal coordinates. False when the forces
-  // are not finite or a body turned too far.
-  bool nonlinear(double t, const Block& z, Block& out, int* flag) {
-    const Block x = phi_ * z;
+  // N(t, z): everything but the modes' linear part, in modal coordinates; x = Phi z is given.
+  // False when the forces are not finite or a body turned too far.
+  bool nonlinear(double t, const Block& z, const Block& x, Block& out, int* flag) {
     if (!states_of(x, y13_.data())) {
       *flag = kTooFar;
       return false;
     }
     state_derivative(context_->model, context_->data, t, y13_.data(), ydot13_.data());
     ++stats_.rhs_evaluations;
-    Block f(n_, 2);  // col 0: dx/dt - u (rotation rows), col 1: accelerations
+    // The accelerations (dv/dt, d^2 theta/dt^2).
     for (size_t b = 0; b < c0_.size(); ++b) {
       const double* s = y13_.data() + kS * b;
       const double* d = ydot13_.data() + kS * b;
@@ -270,13 +354,14 @@ class ModalExponential : public Integrator {
           return false;
         }
       const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
-      const Vec3 theta = x.block<3, 1>(kD * b + 3, 0), omega = x.block<3, 1>(kD * b + 3, 1);
-      f.block<3, 1>(kD * b, 0).setZero();
-      f.block<3, 1>(kD * b + 3, 0) = rotation_vector_rate(theta, omega) - omega;
-      f.block<3, 1>(kD * b, 1) = Vec3(d[7], d[8], d[9]);
-      f.block<3, 1>(kD * b + 3, 1) = a * Vec3(d[10], d[11], d[12]);
+      acceleration_.segment<3>(kD * b) = Vec3(d[7], d[8], d[9]);
+      acceleration_.segment<3>(kD * b + 3) =
+          rotation_vector_acceleration(x.block<3, 1>(kD * b + 3, 0), x.block<3, 1>(kD * b + 3, 1),
+                                       a * Vec3(d[10], d[11], d[12]));
     }
-    out.noalias() = psi_t_ * f;
+    out.resize(n_, 2);
+    out.col(0).setZero();
+    multiply_vector(psi_t_, acceleration_.data(), out.col(1).data());
     out.col(1).array() += lambda_ * z.col(0).array();
     return true;
   }
@@ -293,8 +378,8 @@ class ModalExponential : public Integrator {
         if (f.a[i][j].empty()) continue;
         apply_add(f.a[i][j], lambda_, f.h * stage_n_[j], zi);
       }
-      stage_n_[i].resize(n_, 2);
-      if (!nonlinear(t + StepFunctions::c[i] * f.h, zi, stage_n_[i], flag)) return false;
+      multiply(phi_, zi, xi_);
+      if (!nonlinear(t + StepFunctions::c[i] * f.h, zi, xi_, stage_n_[i], flag)) return false;
     }
     out = Block::Zero(n_, 2);
     apply_add(f.e_full, lambda_, z, out);
@@ -303,10 +388,11 @@ class ModalExponential : public Integrator {
     return true;
   }
 
-  // Weighted RMS norm of a modal error, measured in the physical states (x: rtol |c| + atol for
-  // positions, rtol + atol for rotations; u: rtol |u| + atol).
-  double error_norm(const Block& dz, const Block& z) const {
-    const Block e = phi_ * dz, x = phi_ * z;
+  // Weighted RMS norm of a modal error dz, measured in the physical states (x: rtol |c| + atol
+  // for positions, rtol + atol for rotations; u: rtol |u| + atol) at the physical state x.
+  double error_norm(const Block& dz, const Block& x) {
+    multiply(phi_, dz, e_);
+    const Block& e = e_;
     double sum = 0.0;
     for (size_t b = 0; b < c0_.size(); ++b)
       for (int j = 0; j < kD; ++j) {
@@ -336,7 +422,7 @@ class ModalExponential : public Integrator {
     int flag = kOk;
     Block n0(n_, 2);
     try {
-      if (!nonlinear(t_, z_, n0, &flag)) return fail_flag(flag);
+      if (!nonlinear(t_, z_, x_, n0, &flag)) return fail_flag(flag);
       if (h_ <= 0.0) h_ = options_.initial_step > 0.0 ? options_.initial_step : (target - t_);
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
@@ -355,7 +441,8 @@ class ModalExponential : public Integrator {
           apply_add(full_.e_full, lambda_, z_, low);
           apply_add(full_.low[0], lambda_, h * stage_n_[0], low);
           apply_add(full_.low[1], lambda_, h * stage_n_[1], low);
-          err = error_norm(next - low, next);
+          multiply(phi_, next, x_next_);
+          err = error_norm(next - low, x_next_);
           if (!std::isfinite(err)) err = 1e10;
         } else if (sflag == kNonFinite) {
           // Perhaps a trial state too far out: retry smaller before giving up.
@@ -367,6 +454,7 @@ class ModalExponential : public Integrator {
         if (err <= 1.0) {
           t_ = (h == target - t_) ? target : t_ + h;
           z_ = next;
+          x_.swap(x_next_);
           ++stats_.steps;
           const double grow = err > 0.0 ? 0.9 * std::pow(err, -kExponent) : 4.0;
           if (h >= 0.999 * h_ || grow < 1.0) h_ = h * std::clamp(grow, 0.2, attempt ? 1.0 : 4.0);
@@ -374,8 +462,6 @@ class ModalExponential : public Integrator {
         }
         ++stats_.error_test_failures;
         h_ = h * std::clamp(0.9 * std::pow(err, -kExponent), 0.1, 0.5);
-        ++stats_.error_test_failures;
-        h_ = h * std::clamp(0.9 * std::pow(err, -0.2), 0.1, 0.5);
       }
     } catch (const std::exception& e) {
       context_->callback_error = e.what();
@@ -387,9 +473,9 @@ class ModalExponential : public Integrator {
     if (flag == kTooFar && far_body_ >= 0) {
       const Model& model = context_->model;
       detail_ = "body \"" + model.bodies[model.free_bodies[far_body_]].name +
-                "\" turned more than " + std::to_string(kModalIntegratorMaxRotation) +
-                " rad from its initial orientation: the modal integrator is for small motions "
-                "about the initial configuration; use bdf or dirk";
+                "\" turned more than " + rotation_limit_text() +
+                " from the orientation it is linearized about: the modal integrator is for "
+                "small motions about one configuration; use bdf or dirk";
     }
     return flag;
   }
@@ -402,7 +488,9 @@ class ModalExponential : public Integrator {
   std::vector<Vec3> c0_;
   std::vector<Vec4> q0_;
   std::vector<Mat3> a0_;
-  Block z_;
+  Block z_, x_;                   // the accepted state, modal and physical (x_ = Phi z_)
+  Block xi_, x_next_, e_;         // work space: a stage's physical state, a trial step's, its error
+  Eigen::VectorXd acceleration_;  // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;
   StepFunctions full_;
   Block stage_n_[StepFunctions::kStages];

@@ -1,23 +1,28 @@
-// The "modal" integrator: an exponential Runge-Kutta method in the modal basis of the initial
-// linearization, for small motions about the initial configuration (vibration of stiff
-// structures).
+// The "modal" integrator: an exponential Runge-Kutta method in the modal basis of one
+// linearization, for small motions about one configuration (vibration of stiff structures). The
+// configuration (c0, A0 per free body) is the static equilibrium under the loads at t = 0 or the
+// initial state (IntegratorOptions::about).
 //
 // Generalized coordinates per free body: x = (dc, theta) with c = c0 + dc and A = exp([theta]x) A0
-// (global rotation vector), velocities u = (v, omega) (global). With the mass matrix M0 and the
-// symmetric part K0 of the tangent stiffness at the initial state, and the M0-normalized modes
-// Phi (Phi^T K0 Phi = diag(lambda), Phi^T M0 Phi = I), x = Phi eta, u = Phi nu and
-//   d eta / dt = nu                   + Phi^T M0 (dtheta/dt - omega, rotation rows only)
-//   d nu / dt  = -lambda eta          + Phi^T M0 a(x, u) + lambda eta,
-// a being the exact accelerations (dv/dt, domega/dt) of the equations of motion. Each mode's
+// (global rotation vector), velocities u = dx/dt = (v, dtheta/dt); the angular velocity is
+// omega = J(theta) dtheta/dt (left Jacobian of SO(3), core/model/rotation.hpp), so that dx/dt = u
+// holds exactly and every nonlinearity is in the accelerations. With the mass matrix M0 and the
+// symmetric part K0 of the tangent stiffness at (c0, A0), at rest (theta = 0, where J = I), and
+// the M0-normalized modes Phi (Phi^T K0 Phi = diag(lambda), Phi^T M0 Phi = I), x = Phi eta,
+// u = Phi nu and
+//   d eta / dt = nu,
+//   d nu / dt  = -lambda eta + [Phi^T M0 a(x, u) + lambda eta],
+// a being the exact accelerations (dv/dt, d^2 theta/dt^2) of the equations of motion. Each mode's
 // linear part [[0, 1], [-lambda, 0]] is integrated exactly (phi functions of 2 x 2 blocks); the
-// rest (nonlinearity, load changes, damping, the non-symmetric part) by the stiff-order-4
+// bracket (nonlinearity, load changes, damping, the non-symmetric part) by the stiff-order-4
 // exponential Runge-Kutta method of Hochbruck and Ostermann (2005). Steps are controlled by the
 // distance to an embedded second-order solution from the same stages, measured in the physical
 // states; the fourth-order solution is kept.
 //
-// Cost: one dense eigenproblem (n_dofs^3) at set-up, then two dense n_dofs x n_dofs products per
-// stage; hence a size limit. Accuracy degrades with the size of the motion: past kMaxRotation the
-// run stops with a message naming the body.
+// Cost: one dense eigenproblem (n_dofs^3) at set-up, then per stage one dense product with two
+// columns (x, u = Phi (eta, nu)) and one with one (Phi^T M0 a) (core/analysis/dense_product);
+// hence a size limit. Accuracy degrades with the size of the motion: past kMaxRotation the run
+// stops with a message naming the body.
 #pragma once
 
 #include <array>

@@ -62,6 +62,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
       return result;
     }
     result.linear_solver = integrator->linear_solver;
+    result.warnings = integrator->warnings;
     result.jacobian_nonzeros = integrator->nnz;
 
     const auto deliver = [&](double t) {

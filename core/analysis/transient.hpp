@@ -37,6 +37,10 @@ struct IntegratorOptions {
   double max_step = 0.0;                   // [s]; 0: no limit
   double initial_step = 0.0;               // [s]; 0: the integrator's estimate
   long max_steps = 10000000;               // total step budget over the run
+  // modal: the configuration linearized about: "static" (the equilibrium under the loads at
+  // t = 0), "initial" (the initial state), "" (static when that equilibrium is found within
+  // kModalIntegratorMaxRotation of the initial state, else initial, with a warning).
+  std::string about;
 };
 
 struct TransientOptions {

@@ -108,6 +108,11 @@ BENCHMARK_CAPTURE(ReferenceProblem, modal_rtol5e_5, "modal", "", 5e-5)
     ->Arg(40)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
+BENCHMARK_CAPTURE(ReferenceProblem, modal_rtol8e_5, "modal", "", 8e-5)
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_CAPTURE(ReferenceProblem, modal_rtol1e_4, "modal", "", 1e-4)
     ->Arg(10)
     ->Arg(40)

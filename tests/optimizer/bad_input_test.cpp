@@ -492,6 +492,7 @@ TEST_F(BadInput, WrongEnumValues) {
       {"/scene/beams/0/formulation", "exact", "(expected one of \"energy\", \"paper\")"},
       {"/scene/rails/0/type", "revolute", "(expected one of \"prismatic\", \"cylindrical\")"},
       {"/analyses/0/integrator/method", "rk4", "\"bdf\""},
+      {"/analyses/0/integrator/about", "sideways", "(expected one of \"static\", \"initial\")"},
       {"/scene/loads/0/type", "moment", "(expected one of \"force\", \"torque\")"},
       {"/scene/loads/0/time/type", "sine", "\"ramp\", \"harmonic\", \"table\""},
       {"/scene/sections/sq10/shape", "square", "\"rectangle\", \"circle\""},
@@ -504,6 +505,29 @@ TEST_F(BadInput, WrongEnumValues) {
     EXPECT_TRUE(HasOnlyError(r, std::string("bad.json:") + c.pointer + ":",
                              std::string("unknown value \"") + c.value + "\""));
     EXPECT_NE(r.err.find(c.choices), std::string::npos) << r.err;
+  }
+}
+
+TEST_F(BadInput, IntegratorOptionsOfAnotherMethod) {
+  // Options that belong to one method family, given to another (the base study uses bdf).
+  const struct {
+    const char* key;
+    Json value;
+    const char* message;
+  } cases[] = {
+      {"table", "VERNER_8_5_6", "a Butcher table applies to the \"dirk\" and \"erk\" methods"},
+      {"about", "initial", "applies to the \"modal\" method"},
+      {"stability_limit_detection", true, "applies to the \"bdf\" method"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.key);
+    Json study = base();
+    study["analyses"][0]["integrator"]["method"] =
+        c.key == std::string("stability_limit_detection") ? "dirk" : "bdf";
+    study["analyses"][0]["integrator"][c.key] = c.value;
+    const Result r = check(study);
+    EXPECT_TRUE(
+        HasOnlyError(r, std::string("bad.json:/analyses/0/integrator/") + c.key + ":", c.message));
   }
 }
 

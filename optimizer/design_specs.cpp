@@ -277,6 +277,7 @@ void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
         if (!io.table.empty()) method.label.append(" ").append(io.table);
         if (m.is_object() && m.contains("max_order"))
           method.label.append(" order<=").append(std::to_string(io.max_order));
+        if (!io.about.empty()) method.label.append(" about ").append(io.about);
         if (io.linear_solver != LinearSolverKind::kAuto)
           method.label.append(io.linear_solver == LinearSolverKind::kDense ? " dense" : " sparse");
         p.methods.push_back(method);

@@ -7,8 +7,9 @@ namespace {
 // `kVectors` right-hand sides. Plain loops over i that the compiler vectorizes for each target
 // below.
 template <int kVectors>
-inline void product_kernel(long n, const double* __restrict a, const double* __restrict x,
-                           double* __restrict y) {
+[[gnu::always_inline]] inline void product_kernel(long n, const double* __restrict a,
+                                                  const double* __restrict x,
+                                                  double* __restrict y) {
   for (long i = 0; i < kVectors * n; ++i) y[i] = 0.0;
   constexpr int kBlock = 8;
   long k = 0;

@@ -255,11 +255,21 @@ class ModalExponential : public Integrator {
   // state. False (with *error) when "static" was asked for and no equilibrium was found.
   bool choose_reference(const Model& model, std::vector<double>& reference, std::string* error) {
     if (options_.about == "initial") return true;
+    if (!options_.about.empty() && options_.about != "static")
+      return fail(error, "the modal integrator: unknown \"about\": \"" + options_.about +
+                             "\" (expected \"static\" or \"initial\")");
+    // From the model's initial configuration (solve_static starts there; so does y0).
     Data data(model);
-    set_state(model, data, reference.data());
     StaticOptions statics;
     statics.time = 0.0;
+    statics.structure_cache = context_->structure_cache;
     const StaticResult equilibrium = solve_static(model, statics, data);
+    if (std::chrono::steady_clock::now() > context_->deadline) {
+      context_->timed_out = true;
+      return fail(error,
+                  "timeout: the run exceeded its max_seconds budget (in the modal "
+                  "integrator's static solve)");
+    }
     std::string why;
     if (!equilibrium.ok) {
       why = "no static equilibrium under the loads at t = 0 (" + equilibrium.message + ")";
@@ -276,8 +286,14 @@ class ModalExponential : public Integrator {
       }
     }
     if (!why.empty()) {
-      if (options_.about == "static") return fail(error, "the modal integrator: " + why);
-      warnings.push_back("the modal integrator linearized about the initial state: " + why);
+      if (options_.about == "static")
+        return fail(error, "the modal integrator: " + why +
+                               "; \"about\": \"initial\" linearizes "
+                               "about the initial state");
+      warnings.push_back("the modal integrator linearized about the initial state: " + why +
+                         (equilibrium.ok ? " (the run stops if a body turns more than " +
+                                               rotation_limit_text() + " from there)"
+                                         : ""));
       return true;
     }
     for (int b = 0; b < model.n_free(); ++b) {

@@ -35,7 +35,8 @@ namespace beamrail {
 
 // Largest scene the modal integrator accepts [degrees of freedom = 6 per free body].
 inline constexpr int kModalIntegratorMaxDofs = 1200;
-// Largest rotation of a body from its initial orientation the method follows [rad].
+// Largest rotation of a body from the orientation it is linearized about that the method follows
+// [rad].
 inline constexpr double kModalIntegratorMaxRotation = 1.0;
 
 // g_m(x) = sum_j (-x)^j / (2j + m)!, m = 0..4, at x = lambda tau^2: the phi functions of a mode

@@ -57,6 +57,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     const std::unique_ptr<Integrator> integrator = make_integrator(io, context, ctx, y, &error);
     if (!integrator) {
       result.message = error;
+      result.timed_out = context.timed_out;
       result.stats.wall_seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return result;

@@ -29,6 +29,15 @@ TransientOptions modal(double t_end, double output_step, double rtol, double ato
   return o;
 }
 
+// The tight run a modal run is compared with: ERK (Verner 8(7)) at rtol / atol.
+TransientRun tight_reference(const Model& model, double t_end, double output_step, double rtol,
+                             double atol) {
+  TransientOptions o = options(t_end, output_step, rtol, atol);
+  o.integrator.method = "erk";
+  o.integrator.table = "VERNER_8_5_6";
+  return simulate(model, o);
+}
+
 TEST(ModalIntegrator, OscillatorFunctionsMatchTheirClosedForms) {
   // g_m(x) = sum_j (-x)^j / (2j+m)!; with s = sqrt(x): g0 = cos s, g1 = sin s / s,
   // g2 = (1 - cos s) / x, g3 = (s - sin s) / s^3, g4 = (x/2 - 1 + cos s) / x^2 (cosh, sinh for
@@ -127,10 +136,7 @@ TEST(ModalIntegrator, AgreesWithATightReference) {
   for (const Case& c : cases) {
     const Model model = scene_from_json(c.json);
     const int tip = body_index(model, "tip");
-    TransientOptions tight = options(0.05, 5e-4, 1e-11, 1e-12);
-    tight.integrator.method = "erk";
-    tight.integrator.table = "VERNER_8_5_6";
-    const TransientRun reference = simulate(model, tight);
+    const TransientRun reference = tight_reference(model, 0.05, 5e-4, 1e-11, 1e-12);
     ASSERT_TRUE(reference.result.ok) << reference.result.message;
     for (double rtol : {1e-6, 1e-7}) {
       const TransientRun run = simulate(model, modal(0.05, 5e-4, rtol, 1e-2 * rtol));
@@ -161,10 +167,7 @@ TEST(ModalIntegrator, AgreesWithATightReference) {
 TEST(ModalIntegrator, LinearizesAboutTheLoadedEquilibrium) {
   const Model model = scene_from_json(reference_cantilever(10));
   const int tip = body_index(model, "tip");
-  TransientOptions tight = options(0.05, 5e-4, 1e-11, 1e-12);
-  tight.integrator.method = "erk";
-  tight.integrator.table = "VERNER_8_5_6";
-  const TransientRun reference = simulate(model, tight);
+  const TransientRun reference = tight_reference(model, 0.05, 5e-4, 1e-11, 1e-12);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
   long steps[2] = {0, 0};
   double error[2] = {0.0, 0.0};
@@ -223,8 +226,7 @@ TEST(ModalIntegrator, DoesNotLinearizeAboutAFarEquilibrium) {
   o.integrator.about = "static";
   const TransientRun strict = simulate(model, o);
   EXPECT_FALSE(strict.result.ok);
-  EXPECT_NE(strict.result.message.find("body \"tip\" is turned more than 1 rad"),
-            std::string::npos)
+  EXPECT_NE(strict.result.message.find("body \"tip\" is turned more than 1 rad"), std::string::npos)
       << strict.result.message;
   o.integrator.about = "";
   const TransientRun run = simulate(model, o);
@@ -244,10 +246,7 @@ TEST(ModalIntegrator, RestartsAtLoadBreakpoints) {
                R"({"type": "table", "t": [0, 0.005, 0.01], "v": [0, 1, 0]})");
   const Model model = scene_from_json(json);
   const int tip = body_index(model, "tip");
-  TransientOptions tight = options(0.04, 5e-4, 1e-11, 1e-12);
-  tight.integrator.method = "erk";
-  tight.integrator.table = "VERNER_8_5_6";
-  const TransientRun reference = simulate(model, tight);
+  const TransientRun reference = tight_reference(model, 0.04, 5e-4, 1e-11, 1e-12);
   const TransientRun run = simulate(model, modal(0.04, 5e-4, 1e-7, 1e-9));
   ASSERT_TRUE(reference.result.ok && run.result.ok) << run.result.message;
   ASSERT_EQ(run.samples.size(), reference.samples.size());
@@ -261,10 +260,7 @@ TEST(ModalIntegrator, RestartsAtLoadBreakpoints) {
 TEST(ModalIntegrator, ObservedOrderOfConvergence) {
   const Model model = scene_from_json(reference_cantilever(4));
   const int tip = body_index(model, "tip");
-  TransientOptions tight = options(0.05, 1e-3, 1e-12, 1e-13);
-  tight.integrator.method = "erk";
-  tight.integrator.table = "VERNER_8_5_6";
-  const TransientRun reference = simulate(model, tight);
+  const TransientRun reference = tight_reference(model, 0.05, 1e-3, 1e-12, 1e-13);
   ASSERT_TRUE(reference.result.ok);
   double previous = 0.0;
   double lowest_order = 10.0;

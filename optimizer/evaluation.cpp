@@ -58,10 +58,12 @@ class Runner {
       static_options_ = options;
       static_options_.structure_cache =
           options_.structure_cache ? options_.structure_cache : &structures_;
+      static_options_.max_seconds = budget_left(options.max_seconds);
       static_result_ = solve_static(model_, static_options_, static_data_);
     }
     const StaticResult& r = *static_result_;
     report.ok = r.ok;
+    report.timed_out = r.timed_out;
     report.message = r.message;
     report.wall_seconds = r.wall_seconds;
     report.statics = r;
@@ -91,6 +93,7 @@ class Runner {
           run_static(listed >= 0 ? study_.analyses[listed].statics : StaticOptions{}, false);
       report.statics = equilibrium.statics;
       if (!equilibrium.ok) {
+        report.timed_out = equilibrium.timed_out;
         report.message = "no static equilibrium to linearize about: " + equilibrium.message;
         return report;
       }
@@ -98,8 +101,12 @@ class Runner {
       data.q = static_data_.q;
       options.time = static_options_.time;
     }
+    options.max_seconds = budget_left(options.max_seconds);
     const ModalResult r = solve_modal(model_, options, data);
     report.ok = r.ok;
+    report.timed_out = r.timed_out;
+    report.shift = r.shift;
+    for (const Mode& mode : r.modes) report.noise = std::max(report.noise, mode.noise);
     report.message = r.message;
     report.wall_seconds = r.wall_seconds;
     report.eigensolver = r.solver;
@@ -173,15 +180,19 @@ class Runner {
     return report;
   }
 
+  // An analysis's own max_seconds (0: none) cut to what is left of the evaluation's budget.
+  double budget_left(double own) const {
+    if (options_.max_seconds <= 0.0) return own;
+    const double used =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double left = std::max(1e-3, options_.max_seconds - used);
+    return own > 0.0 ? std::min(own, left) : left;
+  }
+
   // The run's options with max_seconds cut to what is left of the evaluation's budget.
   TransientOptions budgeted(TransientOptions options) {
     options.structure_cache = options_.structure_cache ? options_.structure_cache : &structures_;
-    if (options_.max_seconds > 0.0) {
-      const double used =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-      const double left = std::max(1e-3, options_.max_seconds - used);
-      options.max_seconds = options.max_seconds > 0.0 ? std::min(options.max_seconds, left) : left;
-    }
+    options.max_seconds = budget_left(options.max_seconds);
     return options;
   }
 

@@ -44,6 +44,8 @@ struct AnalysisReport {
   std::string about;  // "static" or "initial"
   std::string eigensolver;
   int modes = 0, rigid_modes = 0;
+  double shift = 0.0;  // of the inverse problem [1/s^2]
+  double noise = 0.0;  // largest Mode::noise among the modes found
   double asymmetry = 0.0;
 };
 

@@ -17,14 +17,15 @@ double structural_mass(const Model& model) {
 }
 
 PointTracker::PointTracker(const Model& model, const ResponseSpec& spec)
-    : body_(spec.body), initial_(spec.point), direction_(spec.direction) {
+    : body_(spec.body), direction_(spec.direction) {
   const Body& b = model.bodies[spec.body];
-  offset_ = rotation_matrix<double>(b.orientation).transpose() * (spec.point - b.position);
+  initial_lever_ = spec.point - b.position;
+  offset_ = rotation_matrix<double>(b.orientation).transpose() * initial_lever_;
 }
 
 double PointTracker::value(const Data& data) const {
   const Pose<double>& p = data.pose[body_];
-  return (p.c + p.A * offset_ - initial_).dot(direction_);
+  return (p.u + (p.A * offset_ - initial_lever_)).dot(direction_);
 }
 
 void static_responses(const Study& study, const Model& model, const Data& data,
@@ -36,8 +37,7 @@ void static_responses(const Study& study, const Model& model, const Data& data,
         values[k] = PointTracker(model, r).value(data);
         break;
       case ResponseSpec::Quantity::kRotation: {
-        const Mat3 a0 = rotation_matrix<double>(model.bodies[r.body].orientation);
-        values[k] = rotation_vector(data.pose[r.body].A * a0.transpose()).dot(r.direction);
+        values[k] = data.rotation[r.body].dot(r.direction);
         break;
       }
       case ResponseSpec::Quantity::kElementForce: {

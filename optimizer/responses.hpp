@@ -20,8 +20,9 @@ class PointTracker {
 
  private:
   int body_;
-  Vec3 offset_;  // body axes
-  Vec3 initial_, direction_;
+  Vec3 offset_;         // body axes
+  Vec3 initial_lever_;  // point - centre in the initial configuration, global
+  Vec3 direction_;
 };
 
 // Fills the static responses (displacement, rotation, element_force, max_stress) from the

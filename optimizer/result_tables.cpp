@@ -11,6 +11,7 @@ bool TimeseriesWriter::open(const std::filesystem::path& path, const Model& mode
   for (int i : model.free_bodies) {
     if (model.bodies[i].generated) continue;
     bodies_.push_back(i);
+    reference_.push_back(model.bodies[i].position);
     for (const char* c : {".x", ".y", ".z", ".q0", ".q1", ".q2", ".q3"})
       header.push_back(model.bodies[i].name + c);
   }
@@ -21,10 +22,11 @@ bool TimeseriesWriter::open(const std::filesystem::path& path, const Model& mode
 void TimeseriesWriter::write(const TransientSample& sample, const Data& data) {
   row_.clear();
   row_.push_back(sample.t);
-  for (int i : bodies_) {
-    const Pose<double>& p = data.pose[i];
+  for (size_t k = 0; k < bodies_.size(); ++k) {
+    const int i = bodies_[k];
+    const Vec3 c = reference_[k] + data.pose[i].u;
     const Vec4 q = data.q[i] / data.q[i].norm();
-    row_.insert(row_.end(), {p.c(0), p.c(1), p.c(2), q(0), q(1), q(2), q(3)});
+    row_.insert(row_.end(), {c(0), c(1), c(2), q(0), q(1), q(2), q(3)});
   }
   row_.push_back(sample.energy());
   table_.row(row_);
@@ -38,9 +40,8 @@ bool write_static_tables(const std::filesystem::path& directory, const Model& mo
     return false;
   for (int i : model.free_bodies) {
     const Body& b = model.bodies[i];
-    const Vec3 d = data.pose[i].c - b.position;
-    const Vec3 r =
-        rotation_vector(data.pose[i].A * rotation_matrix<double>(b.orientation).transpose());
+    const Vec3 d = data.pose[i].u;
+    const Vec3& r = data.rotation[i];
     displacements.row({b.name, format_number(d(0)), format_number(d(1)), format_number(d(2)),
                        format_number(r(0)), format_number(r(1)), format_number(r(2))});
   }

@@ -22,6 +22,7 @@ class TimeseriesWriter {
 
  private:
   std::vector<int> bodies_;
+  std::vector<Vec3> reference_;  // per listed body: its reference position
   std::vector<double> row_;
   CsvWriter table_;
 };

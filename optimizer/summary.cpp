@@ -39,7 +39,9 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
   nlohmann::json analyses = nlohmann::json::array();
   for (const AnalysisReport& a : ev.analyses) {
     nlohmann::json j{{"type", a.type},
-                     {"status", a.ok ? "ok" : a.timed_out ? "timeout" : "failed"},
+                     {"status", a.ok          ? "ok"
+                                : a.timed_out ? "timeout"
+                                              : "failed"},
                      {"message", a.message},
                      {"wall_seconds", a.wall_seconds}};
     if (a.type == "transient") {
@@ -77,7 +79,10 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
                         {"load_steps", r.load_steps},
                         {"residual_norm", json_number(r.residual_norm)},
                         {"reference_force", json_number(r.reference_force)},
+                        {"rounding_floor", json_number(r.rounding_floor)},
+                        {"last_correction", json_number(r.correction)},
                         {"singular_directions", r.singular_directions},
+                        {"negative_stiffness_directions", r.negative_directions},
                         {"wall_seconds", r.wall_seconds}};
       if (a.type == "static")
         j.update(st);
@@ -89,6 +94,8 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["eigensolver"] = a.eigensolver;
       j["elastic_modes"] = a.modes;
       j["rigid_body_modes"] = a.rigid_modes;
+      j["shift"] = json_number(a.shift);
+      j["largest_noise"] = json_number(a.noise);
       j["stiffness_asymmetry"] = json_number(a.asymmetry);
     }
     analyses.push_back(j);

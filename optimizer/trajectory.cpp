@@ -14,7 +14,7 @@ Trajectory trajectory_of(const Model& model) {
 
 void Trajectory::record(const TransientSample& sample, const Data& data) {
   times.push_back(sample.t);
-  for (int i : bodies) positions.push_back(data.pose[i].c);
+  for (int i : bodies) positions.push_back(data.pose[i].u);
 }
 
 double trajectory_error(const Trajectory& run, const Trajectory& reference) {

@@ -11,7 +11,7 @@ namespace beamrail {
 struct Trajectory {
   std::vector<int> bodies;      // the scene's own free bodies
   std::vector<double> times;    // [s]
-  std::vector<Vec3> positions;  // centre of each body at each time, time-major
+  std::vector<Vec3> positions;  // displacement of each body's centre at each time, time-major
   void record(const TransientSample& sample, const Data& data);
 };
 

@@ -1,15 +1,18 @@
 #include "core/analysis/modal_analysis.hpp"
 
 #include <Spectra/MatOp/SparseSymMatProd.h>
-#include <Spectra/MatOp/SymShiftInvert.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <stdexcept>
 
+#include "core/analysis/element_deformation.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
 
@@ -17,171 +20,179 @@ namespace beamrail {
 namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
+using Clock = std::chrono::steady_clock;
 
-// Classifies eigenpairs, normalizes shapes, and keeps the rigid modes plus `wanted` others.
-// scales(i): the spectrum scale eigenvalue i is compared with to recognise a rigid mode.
-void classify(const Eigen::VectorXd& values, const Eigen::MatrixXd& vectors, const SparseMatrix& m,
-              const Eigen::VectorXd& scales, int wanted, ModalResult& result) {
-  std::vector<int> order(values.size());
-  for (int i = 0; i < static_cast<int>(order.size()); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return values(a) < values(b); });
-  int elastic = 0;
-  for (int i : order) {
-    Mode mode;
-    mode.eigenvalue = values(i);
-    if (std::abs(values(i)) <= kRigidModeThreshold * scales(i)) {
-      mode.kind = Mode::Kind::kRigid;
-      ++result.rigid_modes;
-    } else if (values(i) < 0.0) {
-      mode.kind = Mode::Kind::kUnstable;
-      mode.frequency_hz = -std::sqrt(-values(i)) / (2 * std::numbers::pi);
-    } else {
-      if (elastic == wanted) continue;
-      ++elastic;
-      mode.frequency_hz = std::sqrt(values(i)) / (2 * std::numbers::pi);
-    }
-    Eigen::VectorXd x = vectors.col(i);
-    x /= std::sqrt(x.dot(m * x));
-    Eigen::Index big = 0;
-    x.cwiseAbs().maxCoeff(&big);
-    if (x(big) < 0) x = -x;
-    mode.shape = x;
-    result.modes.push_back(std::move(mode));
+// Thrown out of an eigensolver's iterations when the analysis's budget is spent.
+struct BudgetSpent {};
+
+struct Budget {
+  bool active = false;
+  Clock::time_point end;
+  void check() const {
+    if (active && Clock::now() > end) throw BudgetSpent{};
   }
-  for (const Mode& mode : result.modes)
-    if (mode.kind == Mode::Kind::kUnstable)
-      result.warnings.push_back(
-          "the configuration is unstable (a mode has negative stiffness: "
-          "buckling or an unstable equilibrium)");
+};
+
+// The shift mu of the inverse problem. 0 when the elastic stiffness is positive definite: the
+// inverse problem then resolves the lowest eigenvalue to its own relative accuracy however stiff
+// the rest is. Otherwise a small multiple of the stiffness scale, far enough above rounding
+// (eps times the largest K_ii / M_ii) that K + mu M stays definite along rigid directions.
+double choose_shift(const Model& model, const SparseMatrix& k, const SparseMatrix& m) {
+  if (held_by_beams(model)) return 0.0;
+  double scale = 0.0;
+  for (Eigen::Index i = 0; i < k.rows(); ++i)
+    scale = std::max(scale, std::abs(k.coeff(i, i)) / m.coeff(i, i));
+  return scale > 0.0 ? 1e4 * std::numeric_limits<double>::epsilon() * scale : 1.0;
 }
 
-// Groups of free bodies coupled by stiffness (the mass matrix is block-diagonal per body): their
-// eigenproblems are independent. Each group's degrees of freedom, ascending.
-std::vector<std::vector<int>> coupled_groups(const Model& model) {
-  const int n = model.n_free();
-  std::vector<int> parent(n);
-  for (int i = 0; i < n; ++i) parent[i] = i;
-  const auto root = [&](int i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  for (const auto& b : model.pattern.blocks) parent[root(b.row)] = root(b.col);
-  std::vector<std::vector<int>> groups;
-  std::vector<int> slot(n, -1);
-  for (int i = 0; i < n; ++i) {
-    int& g = slot[root(i)];
-    if (g < 0) {
-      g = static_cast<int>(groups.size());
-      groups.emplace_back();
-    }
-    for (int d = 0; d < kDofsPerBody; ++d) groups[g].push_back(kDofsPerBody * i + d);
+// y = (K - sigma M)^-1 x for Spectra's shift-invert mode, by a sparse LDL^T (fill-reducing
+// ordering; K - sigma M is definite, or mildly indefinite about an unstable configuration).
+class ShiftSolve {
+ public:
+  using Scalar = double;
+  ShiftSolve(const SparseMatrix& k, const SparseMatrix& m, const Budget& budget)
+      : k_(k), m_(m), budget_(budget) {}
+  Eigen::Index rows() const { return k_.rows(); }
+  Eigen::Index cols() const { return k_.cols(); }
+  void set_shift(double sigma) {
+    const SparseMatrix a = k_ - sigma * m_;
+    ldlt_.compute(a);
+    if (ldlt_.info() != Eigen::Success)
+      throw std::runtime_error("the shifted stiffness K + mu M could not be factored");
   }
-  return groups;
+  void perform_op(const double* x, double* y) const {
+    budget_.check();
+    Eigen::Map<Eigen::VectorXd>(y, rows()) =
+        ldlt_.solve(Eigen::Map<const Eigen::VectorXd>(x, rows()));
+  }
+
+ private:
+  const SparseMatrix& k_;
+  const SparseMatrix& m_;
+  const Budget& budget_;
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+};
+
+struct Eigenpairs {
+  Eigen::VectorXd values;
+  Eigen::MatrixXd vectors;  // columns
+};
+
+bool solve_dense(const SparseMatrix& k, const SparseMatrix& m, double shift, Eigenpairs& out) {
+  return solve_dense_eigenproblem(Eigen::MatrixXd(k), Eigen::MatrixXd(m), out.values, out.vectors,
+                                  shift);
 }
 
-bool solve_dense(const Model& model, const SparseMatrix& k, const SparseMatrix& m, int wanted,
-                 ModalResult& result) {
-  const Eigen::MatrixXd kd(k), md(m);
-  const Eigen::Index n = kd.rows();
-  Eigen::VectorXd values(n), scales(n);
-  Eigen::MatrixXd vectors = Eigen::MatrixXd::Zero(n, n);
-  Eigen::Index next = 0;
-  // Each coupled group on its own: rigid modes are recognised against the group's own spectrum,
-  // so a stiff part does not turn the modes of an independent soft part into rigid ones.
-  for (const std::vector<int>& dofs : coupled_groups(model)) {
-    const Eigen::Index g = static_cast<Eigen::Index>(dofs.size());
-    Eigen::MatrixXd kg(g, g), mg(g, g);
-    for (Eigen::Index r = 0; r < g; ++r)
-      for (Eigen::Index c = 0; c < g; ++c) {
-        kg(r, c) = kd(dofs[r], dofs[c]);
-        mg(r, c) = md(dofs[r], dofs[c]);
-      }
-    Eigen::VectorXd gv;
-    Eigen::MatrixXd gx;
-    if (!solve_dense_eigenproblem(kg, mg, gv, gx)) {
-      result.message = "the dense eigensolver failed";
-      return false;
-    }
-    const double scale = gv.cwiseAbs().maxCoeff();
-    for (Eigen::Index i = 0; i < g; ++i, ++next) {
-      values(next) = gv(i);
-      scales(next) = scale;
-      for (Eigen::Index r = 0; r < g; ++r) vectors(dofs[r], next) = gx(r, i);
-    }
-  }
-  classify(values, vectors, m, scales, wanted, result);
-  result.solver = "dense";
+// The `count` eigenpairs nearest the shift -mu by Lanczos; false when it did not converge.
+bool solve_lanczos(const SparseMatrix& k, const SparseMatrix& m, double shift, Eigen::Index count,
+                   const Budget& budget, Eigenpairs& out) {
+  const Eigen::Index n = k.rows();
+  const Eigen::Index nev = std::min<Eigen::Index>(n - 1, count);
+  const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
+  ShiftSolve op(k, m, budget);
+  Spectra::SparseSymMatProd<double> bop(m);
+  Spectra::SymGEigsShiftSolver<ShiftSolve, Spectra::SparseSymMatProd<double>,
+                               Spectra::GEigsMode::ShiftInvert>
+      eigs(op, bop, nev, ncv, -shift);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+  if (eigs.info() != Spectra::CompInfo::Successful) return false;
+  out.values = eigs.eigenvalues();
+  out.vectors = eigs.eigenvectors();
   return true;
 }
 
-bool solve_shift_invert(const SparseMatrix& k, const SparseMatrix& m, int wanted,
-                        ModalResult& result) {
-  const Eigen::Index n = k.rows();
-  // Scale of the spectrum from the diagonal, to place a small negative shift below the rigid
-  // modes (K is singular when the scene floats or holds a mechanism).
-  double scale = 0.0;
-  for (Eigen::Index i = 0; i < n; ++i)
-    scale = std::max(scale, k.coeff(i, i) / std::max(m.coeff(i, i), 1e-300));
-  const double sigma = -1e-6 * scale;
-  for (int extra : {12, 48, 192}) {
-    const Eigen::Index nev = std::min<Eigen::Index>(n - 2, wanted + extra);
-    const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
-    using Op = Spectra::SymShiftInvert<double, Eigen::Sparse, Eigen::Sparse>;
-    using BOp = Spectra::SparseSymMatProd<double>;
-    Op op(k, m);
-    BOp bop(m);
-    Spectra::SymGEigsShiftSolver<Op, BOp, Spectra::GEigsMode::ShiftInvert> eigs(op, bop, nev, ncv,
-                                                                                sigma);
-    eigs.init();
-    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
-    if (eigs.info() != Spectra::CompInfo::Successful) {
-      result.message = "the shift-invert eigensolver did not converge";
-      return false;
+// Builds the modes (ascending), classifying each by the element deformation of its shape; keeps
+// every rigid mode and at most `wanted` others. Returns the number of non-rigid modes among
+// the pairs (kept or not).
+int classify(const Eigenpairs& pairs, const SparseMatrix& m, const ElementDeformation& deformation,
+             double shift, int wanted, ModalResult& result) {
+  std::vector<Eigen::Index> order(pairs.values.size());
+  for (Eigen::Index i = 0; i < pairs.values.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](Eigen::Index a, Eigen::Index b) { return pairs.values(a) < pairs.values(b); });
+  // A rigid mode's eigenvalue is load stiffness only; below this it is rounding of the shift.
+  const double resolution = 1e-6 * shift;
+  int others = 0;
+  result.modes.clear();
+  result.rigid_modes = 0;
+  for (Eigen::Index i : order) {
+    Mode mode;
+    mode.eigenvalue = pairs.values(i);
+    Eigen::VectorXd x = pairs.vectors.col(i);
+    x /= std::sqrt(x.dot(m * x));
+    mode.deformation = deformation.ratio(x);
+    if (mode.deformation <= kRigidModeDeformation) {
+      mode.kind = Mode::Kind::kRigid;
+      ++result.rigid_modes;
+      if (std::abs(mode.eigenvalue) <= resolution) mode.eigenvalue = 0.0;
+    } else {
+      if (others++ >= wanted) continue;
+      mode.kind = mode.eigenvalue < 0.0 ? Mode::Kind::kUnstable : Mode::Kind::kElastic;
     }
-    const Eigen::VectorXd values = eigs.eigenvalues();
-    ModalResult trial;
-    classify(values, eigs.eigenvectors(), m, Eigen::VectorXd::Constant(values.size(), scale),
-             wanted, trial);
-    const int elastic = static_cast<int>(trial.modes.size()) - trial.rigid_modes;
-    if (elastic >= wanted || nev >= n - 2) {
-      result.modes = std::move(trial.modes);
-      result.rigid_modes = trial.rigid_modes;
-      result.warnings.insert(result.warnings.end(), trial.warnings.begin(), trial.warnings.end());
-      result.solver = "shift-invert";
-      return true;
-    }
+    mode.frequency_hz = std::copysign(std::sqrt(std::abs(mode.eigenvalue)), mode.eigenvalue) /
+                        (2 * std::numbers::pi);
+    Eigen::Index big = 0;
+    x.cwiseAbs().maxCoeff(&big);
+    if (x(big) < 0) x = -x;
+    mode.shape = std::move(x);
+    result.modes.push_back(std::move(mode));
   }
-  result.message = "could not find the requested number of elastic modes";
-  return false;
+  return others;
 }
 
 }  // namespace
 
 bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& md,
-                              Eigen::VectorXd& values, Eigen::MatrixXd& vectors) {
+                              Eigen::VectorXd& values, Eigen::MatrixXd& vectors, double shift) {
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(kd, md);
   if (eig.info() != Eigen::Success) return false;
   values = eig.eigenvalues();  // ascending
   vectors = eig.eigenvectors();
   const Eigen::Index n = values.size();
-  const double top = values.cwiseAbs().maxCoeff();
-  if (n < 2 || !(values(0) > kRigidModeThreshold * top) || values(n - 1) < 1e6 * values(0))
-    return true;
-  const Eigen::LLT<Eigen::MatrixXd> kf(kd);
+  if (n < 2) return true;
+  double mu = shift;
+  if (mu < 0.0) {
+    // No shift given: the inverse problem only for a positive definite K of a wide spectrum.
+    const double top = values.cwiseAbs().maxCoeff();
+    if (!(values(0) > 1e-12 * top) || values(n - 1) < 1e6 * values(0)) return true;
+    mu = 0.0;
+  }
+  const Eigen::MatrixXd a = kd + mu * md;
   const Eigen::LLT<Eigen::MatrixXd> mf(md);
-  if (kf.info() != Eigen::Success || mf.info() != Eigen::Success) return true;
-  // With M = L L^T: B = L^T K^-1 L has eigenvalues 1/w^2 and eigenvectors y = L^T x.
+  if (mf.info() != Eigen::Success) return true;
+  // With M = L L^T: B = L^T (K + mu M)^-1 L has eigenvalues 1/(w^2 + mu), eigenvectors L^T x.
+  // Cholesky where K + mu M is positive definite (the usual case), else a pivoted LDL^T.
   const Eigen::MatrixXd l = mf.matrixL();
-  Eigen::MatrixXd b = l.transpose() * kf.solve(l);
+  Eigen::MatrixXd b;
+  if (const Eigen::LLT<Eigen::MatrixXd> llt(a); llt.info() == Eigen::Success) {
+    b = l.transpose() * llt.solve(l);
+  } else {
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+    if (ldlt.info() != Eigen::Success) return true;
+    b = l.transpose() * ldlt.solve(l);
+  }
+  if (!b.allFinite()) return true;
   b = 0.5 * (b + b.transpose()).eval();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> inv(b);
-  if (inv.info() != Eigen::Success || !(inv.eigenvalues().minCoeff() > 0.0)) return true;
+  if (inv.info() != Eigen::Success) return true;
+  // nu = 1/(w^2 + mu): the largest |nu| are the eigenvalues nearest -mu. Order them by w^2.
+  const Eigen::VectorXd nu = inv.eigenvalues();
   const Eigen::MatrixXd x = mf.matrixU().solve(inv.eigenvectors());
-  const double middle = std::sqrt(values(0) * values(n - 1));
-  for (Eigen::Index i = 0; i < n && values(i) < middle; ++i) {
-    const Eigen::Index j = n - 1 - i;  // 1/w^2 ascending: the i-th smallest w^2 is last but i
-    values(i) = 1.0 / inv.eigenvalues()(j);
-    vectors.col(i) = x.col(j);
+  std::vector<Eigen::Index> order(n);
+  for (Eigen::Index i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](Eigen::Index a, Eigen::Index c) { return 1.0 / nu(a) < 1.0 / nu(c); });
+  // The inverse problem resolves w^2 to ~eps (w^2 + mu) / min |w^2 + mu|, the direct one to
+  // ~eps lambda_max / w^2: the inverse below their geometric mean, the direct above.
+  const double top = values.cwiseAbs().maxCoeff();
+  const double bottom = 1.0 / nu.cwiseAbs().maxCoeff();
+  const double middle = std::sqrt(top * bottom);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double lambda = 1.0 / nu(order[i]) - mu;
+    if (!(std::abs(lambda + mu) < middle) || !std::isfinite(lambda)) break;
+    values(i) = lambda;
+    vectors.col(i) = x.col(order[i]);
   }
   return true;
 }
@@ -194,8 +205,14 @@ const Mode* elastic_mode(const ModalResult& result, int k) {
 }
 
 ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& data) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   ModalResult result;
+  Budget budget;
+  if (options.max_seconds > 0.0) {
+    budget.active = true;
+    budget.end = start + std::chrono::duration_cast<Clock::duration>(
+                             std::chrono::duration<double>(options.max_seconds));
+  }
   try {
     compute_wrenches(model, data, options.time, options.load_factor);
     compute_tangent(model, data, options.time, false, options.load_factor);
@@ -211,23 +228,97 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     const double norm = kn.norm();
     result.asymmetry = norm > 0.0 ? (kn - SparseMatrix(kn.transpose())).norm() / norm : 0.0;
     const int wanted = std::max(1, options.modes);
-    const bool dense =
-        options.solver == EigenSolverKind::kDense ||
-        (options.solver == EigenSolverKind::kAuto && model.n_dofs <= options.dense_limit) ||
-        model.n_dofs < 2 * wanted + 24;
-    result.ok = dense ? solve_dense(model, sym, m, wanted, result)
-                      : solve_shift_invert(sym, m, wanted, result);
+    const Eigen::Index n = model.n_dofs;
+    const bool dense = options.solver == EigenSolverKind::kDense ||
+                       (options.solver == EigenSolverKind::kAuto && n <= options.dense_limit) ||
+                       n < 2 * wanted + 24;
+    result.shift = choose_shift(model, sym, m);
+    const ElementDeformation deformation(model, data);
+
+    int found = 0;  // non-rigid modes among the pairs computed
+    if (dense) {
+      Eigenpairs pairs;
+      if (!solve_dense(sym, m, result.shift, pairs))
+        throw std::runtime_error("the dense eigensolver failed");
+      budget.check();
+      found = classify(pairs, m, deformation, result.shift, wanted, result);
+      result.solver = "dense";
+    } else {
+      // Rigid modes take places among the pairs nearest the shift: ask for more until enough
+      // non-rigid ones are among them or every pair is.
+      for (Eigen::Index extra = 12;; extra *= 4) {
+        const Eigen::Index count = std::min<Eigen::Index>(n - 1, wanted + extra);
+        Eigenpairs pairs;
+        if (!solve_lanczos(sym, m, result.shift, count, budget, pairs))
+          throw std::runtime_error("the shift-invert eigensolver did not converge");
+        found = classify(pairs, m, deformation, result.shift, wanted, result);
+        if (found >= wanted || count >= n - 1) break;
+      }
+      result.solver = "shift-invert";
+    }
+    result.ok = true;
+    // Resolution of each non-rigid mode against the rounding of the stiffness terms.
+    const SparseMatrix k_abs = sym.cwiseAbs();
+    const Eigen::VectorXd weight = Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse();
+    double worst = 0.0;
+    int worst_mode = 0, number = 0;
+    for (Mode& mode : result.modes) {
+      if (mode.kind == Mode::Kind::kRigid) continue;
+      ++number;
+      mode.noise = std::numeric_limits<double>::epsilon() *
+                   weight.cwiseProduct(k_abs * mode.shape.cwiseAbs()).norm() /
+                   std::abs(mode.eigenvalue);
+      if (!(mode.noise <= worst)) worst = mode.noise, worst_mode = number;
+    }
+    const std::string noise_text = "mode " + std::to_string(worst_mode) +
+                                   ": the rounding of the stiffness terms reaches " +
+                                   std::to_string(worst) +
+                                   " of its inertia forces (chains of very many short segments "
+                                   "span more decades of stiffness than double precision holds)";
+    if (!(worst <= kModalNoiseLimit)) {
+      result.ok = false;
+      result.message =
+          "the modes are not resolved in double precision: " + noise_text + "; use fewer segments";
+    } else if (worst > kModalNoiseWarning) {
+      char digits[96];
+      std::snprintf(digits, sizeof digits,
+                    "the frequencies are resolved to ~%.0e only: ", kModalNoiseError * worst);
+      result.warnings.push_back(digits + noise_text);
+    }
+    if (result.ok && found < wanted) {
+      result.ok = false;
+      result.message = "asked for " + std::to_string(wanted) + " elastic mode" +
+                       (wanted == 1 ? "" : "s") + ", but the scene has " +
+                       (found == 0 ? std::string("none") : "only " + std::to_string(found)) +
+                       ": its " + std::to_string(n) + " degrees of freedom include " +
+                       std::to_string(result.rigid_modes) +
+                       " rigid-body or mechanism mode(s), which deform no element";
+    }
+    int unstable = 0;
+    for (const Mode& mode : result.modes)
+      unstable += mode.eigenvalue < 0.0 &&
+                  (mode.kind != Mode::Kind::kRigid || mode.eigenvalue < -1e-6 * result.shift);
+    if (unstable > 0 && result.ok) {
+      result.ok = false;
+      result.message =
+          "the configuration is not a stable equilibrium: " + std::to_string(unstable) +
+          " mode(s) with negative stiffness (buckling, or an unstable equilibrium)";
+    }
     if (result.ok && result.asymmetry > 1e-6)
       result.warnings.push_back("the tangent stiffness is not symmetric (relative asymmetry " +
                                 std::to_string(result.asymmetry) +
                                 "): the configuration is not an equilibrium; its symmetric part "
                                 "was used");
+  } catch (const BudgetSpent&) {
+    result.ok = false;
+    result.timed_out = true;
+    result.modes.clear();
+    result.message = "the modal analysis did not finish within its time budget";
   } catch (const std::exception& e) {
     result.ok = false;
     result.message = e.what();
   }
-  result.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return result;
 }
 

@@ -1,17 +1,28 @@
 #include "core/analysis/static_analysis.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 
 #include "core/analysis/deformation_check.hpp"
+#include "core/model/element_kinematics.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
 
 namespace beamrail {
 namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+std::string format(const char* pattern, double a, double b = 0.0) {
+  char text[400];
+  std::snprintf(text, sizeof text, pattern, a, b);
+  return text;
+}
 
 // Largest element length, the length that turns moments into forces in the residual norm.
 double characteristic_length(const Model& model) {
@@ -24,28 +35,13 @@ double characteristic_length(const Model& model) {
 // The load scale: the largest applied force (moments / length) or weight, at full load.
 double reference_force(const Model& model, double t, double length) {
   double f = 0.0;
-  for (int i : model.free_bodies) f = std::max(f, model.bodies[i].mass * model.gravity.norm());
+  for (int i : model.free_bodies)
+    f = std::max(f, model.bodies[i].mass * model.gravity.stableNorm());
   for (const Load& load : model.loads) {
-    const double v = std::abs(load.time(t)) * load.value.norm();
+    const double v = std::abs(load.time(t)) * load.value.stableNorm();
     f = std::max(f, load.kind == LoadKind::kForce ? v : v / length);
   }
   return f;
-}
-
-// The residual that rounding alone leaves: element forces come from coordinates stored absolutely,
-// so an element of axial stiffness EA/l at distance |p| from the origin carries force noise
-// ~ eps EA |p| / l (bending adds far less). Newton cannot go below a small multiple of it.
-double rounding_floor(const Model& model, const Data& data) {
-  double floor = 0.0;
-  const auto add = [&](const ElementEnds& e, double axial, double bending) {
-    const double reach =
-        std::max({data.pose[e.body1].c.norm(), data.pose[e.body2].c.norm(), e.length, 1e-300});
-    floor =
-        std::max(floor, (axial / e.length + bending / (e.length * e.length * e.length)) * reach);
-  };
-  for (const Beam& e : model.beams) add(e.ends, e.ea, 12.0 * std::max(e.eiy, e.eiz));
-  for (const Rail& e : model.rails) add(e.ends, 0.0, 12.0 * std::max(e.eiy, e.eiz));
-  return 16.0 * std::numeric_limits<double>::epsilon() * floor;
 }
 
 double scaled_norm(const Eigen::VectorXd& w, double length) {
@@ -55,10 +51,34 @@ double scaled_norm(const Eigen::VectorXd& w, double length) {
   return n;
 }
 
-// A factorized tangent, reused for the simplified Newton corrections of the monotonicity test.
-// KLU factors it with the symbolic analysis of the topology's velocity-level pattern (6 x 6 per
-// coupled body pair: exactly the tangent's), shared between designs. Falls back to the
-// minimum-norm solution when the tangent is singular (free mechanisms).
+// Size of a motion in metres (rotations times the characteristic length).
+double motion_size(const Eigen::VectorXd& x, double length) {
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    const double v = (i % kDofsPerBody) < 3 ? x(i) : x(i) * length;
+    sum += v * v;
+  }
+  return std::sqrt(sum);
+}
+
+// The displacement of every free body from the initial configuration (u, rotation vector).
+Eigen::VectorXd displacement(const Model& model, const Data& data) {
+  Eigen::VectorXd x(model.n_dofs);
+  for (int k = 0; k < model.n_free(); ++k) {
+    const int i = model.free_bodies[k];
+    x.segment<3>(kDofsPerBody * k) = data.pose[i].u;
+    x.segment<3>(kDofsPerBody * k + 3) = data.rotation[i];
+  }
+  return x;
+}
+
+// A factorized tangent. KLU factors it with the symbolic analysis of the topology's velocity-level
+// pattern (6 x 6 per coupled body pair: exactly the tangent's), shared between designs. Falls back
+// to the minimum-norm solution of a dense decomposition when KLU's factors are unsound (free
+// mechanisms, or a tangent whose entries span too many decades for its pivot test). That one sees
+// the tangent equilibrated by its diagonal, D S D with D = |diag S|^-1/2, so that its rank test
+// compares like with like: forces per metre and moments per radian can differ by orders of
+// magnitude (a 1 nm beam: 12 EI / l^3 = 2e30 N/m beside 4 EI / l = 7e11 N m).
 class TangentSolver {
  public:
   explicit TangentSolver(std::shared_ptr<const SparseStructure> structure)
@@ -71,6 +91,12 @@ class TangentSolver {
 
   bool factorize(const Model& model, const Data& data, std::string* failure) {
     matrix_ = stiffness_matrix(model, data);
+    scale_.resize(matrix_.rows());
+    for (Eigen::Index i = 0; i < matrix_.rows(); ++i) {
+      const double d = std::abs(matrix_.coeff(i, i));
+      scale_(i) = d > 0.0 && std::isfinite(d) ? 1.0 / std::sqrt(d) : 1.0;
+    }
+    scaled_ = scale_.asDiagonal() * matrix_ * scale_.asDiagonal();
     use_dense_ = false;
     null_directions = 0;
     if (!structure_) return factorize_dense();
@@ -105,14 +131,18 @@ class TangentSolver {
       }
     }
     if (matrix_.rows() > 3000) {
-      *failure = "the tangent stiffness is singular (a body or mechanism is free to move)";
+      *failure = held_by_beams(model)
+                     ? "the tangent stiffness is singular or indefinite: the structure buckles or "
+                       "snaps through under these loads"
+                     : "the tangent stiffness is singular: a body or mechanism is free to move, "
+                       "or the structure buckles under these loads";
       return false;
     }
     return factorize_dense();
   }
   // The minimum-norm solution by a complete orthogonal decomposition.
   bool factorize_dense() {
-    const Eigen::MatrixXd dense(matrix_);
+    const Eigen::MatrixXd dense(scaled_);
     cod_.setThreshold(1e-12);
     cod_.compute(dense);
     null_directions = static_cast<int>(dense.rows() - cod_.rank());
@@ -120,12 +150,23 @@ class TangentSolver {
     return true;
   }
   Eigen::VectorXd apply(const Eigen::VectorXd& x) const { return matrix_ * x; }
+  // S^-1 b (the minimum-norm solution, in the equilibrated variables, when S is singular).
   Eigen::VectorXd solve(const Eigen::VectorXd& b) {
-    if (use_dense_) return cod_.solve(b);
+    if (use_dense_) return scale_.cwiseProduct(cod_.solve(scale_.cwiseProduct(b)));
     Eigen::VectorXd x = b;
     if (!klu_l_solve(structure_->symbolic(), numeric_, x.size(), 1, x.data(), &common_))
       x.setConstant(std::numeric_limits<double>::quiet_NaN());
     return x;
+  }
+  // What rounding leaves in a residual evaluated at displacement x: the stiffness terms that
+  // cancel in it each carry eps of their size, eps |S| (|x| + r), where r (the element length for
+  // translations, 1 rad for rotations) stands for the rounding of the element chords and relative
+  // rotations themselves (scaled like the residual).
+  double rounding_floor(const Eigen::VectorXd& x, double length) const {
+    Eigen::VectorXd reach = x.cwiseAbs();
+    for (Eigen::Index i = 0; i < reach.size(); ++i)
+      reach(i) += (i % kDofsPerBody) < 3 ? length : 1.0;
+    return scaled_norm(kEps * (matrix_.cwiseAbs() * reach), length);
   }
   int null_directions = 0;
 
@@ -133,40 +174,98 @@ class TangentSolver {
   void free_numeric() {
     if (numeric_) klu_l_free_numeric(&numeric_, &common_);
   }
+
   std::shared_ptr<const SparseStructure> structure_;
   klu_l_common common_;
   klu_l_numeric* numeric_ = nullptr;
   std::vector<double> values_;
-  Eigen::SparseMatrix<double> matrix_;
+  Eigen::SparseMatrix<double> matrix_, scaled_;
+  Eigen::VectorXd scale_;  // D
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
   bool use_dense_ = false;
 };
 
+struct Budget {
+  bool active = false;
+  Clock::time_point end;
+  bool spent() const { return active && Clock::now() > end; }
+};
+
 struct Newton {
+  Newton(const Model& m, Data& d, double time, double len, int max_it, const Budget& b,
+         std::shared_ptr<const SparseStructure> structure)
+      : model(m),
+        data(d),
+        t(time),
+        length(len),
+        max_iterations(max_it),
+        budget(b),
+        solver(std::move(structure)) {}
   const Model& model;
   Data& data;
   double t, length;
   int max_iterations;
+  const Budget& budget;
+  TangentSolver solver;
   int iterations = 0;
   int singular = 0;
   double residual = 0.0;
+  double floor = 0.0;       // rounding floor at the last tangent
+  double correction = 0.0;  // last correction / displacement
   std::string failure;
-  TangentSolver solver;
-  bool no_equilibrium = false;
+  bool final = false;  // no smaller load step can help (no equilibrium, precision, budget)
+
+  struct Saved {
+    std::vector<Pose<double>> pose;
+    std::vector<Vec4> q;
+    std::vector<Vec3> rotation;
+  };
+  Saved save() const { return {data.pose, data.q, data.rotation}; }
+  void restore(const Saved& s) {
+    data.pose = s.pose;
+    data.q = s.q;
+    data.rotation = s.rotation;
+  }
 
   double residual_at(double factor) {
     compute_wrenches(model, data, t, factor);
     return scaled_norm(wrench_vector(model, data), length);
   }
 
-  // Size of a correction in metres (rotations times the characteristic length).
-  double size(const Eigen::VectorXd& dx) const {
-    double sum = 0.0;
-    for (Eigen::Index i = 0; i < dx.size(); ++i) {
-      const double v = (i % kDofsPerBody) < 3 ? dx(i) : dx(i) * length;
-      sum += v * v;
+  bool fail(std::string why, bool no_smaller_step) {
+    failure = std::move(why);
+    final = no_smaller_step;
+    return false;
+  }
+
+  // The carriages' positions along their rails (xi_x) in the current configuration.
+  std::vector<double> carriage_positions() const {
+    std::vector<double> out;
+    for (const Rail& e : model.rails)
+      out.push_back(element_frames(e.ends, data.pose[e.ends.body1], data.pose[e.ends.body2],
+                                   e.type == RailType::kCylindrical)
+                        .xi(0));
+    return out;
+  }
+
+  // A carriage that a Newton iterate moved along its rail by more than kRailTravelWarning times
+  // its distance from point 1 at the start of the load step: the loads push it along the rail,
+  // where nothing holds it (a smaller load step is tried; a carriage that runs away at every load
+  // step has no equilibrium).
+  std::string runaway_carriage(const std::vector<double>& start) const {
+    const std::vector<double> now = carriage_positions();
+    for (size_t k = 0; k < model.rails.size(); ++k) {
+      const Rail& e = model.rails[k];
+      if (std::abs(now[k] - start[k]) >
+          kRailTravelWarning * std::max(std::abs(start[k]), e.min_length))
+        return "the carriage of rail \"" + e.name +
+               "\" ran away along the rail in a Newton iterate " +
+               format(
+                   "(from %.3g m to %.3g m from point 1): the loads push it along the rail, "
+                   "which does not hold it: there is no equilibrium",
+                   start[k], now[k]);
     }
-    return std::sqrt(sum);
+    return "";
   }
 
   // Newton iterations at load factor `factor` from the current state; true when converged.
@@ -178,50 +277,61 @@ struct Newton {
   // test with the old tangent (which does not see the tension) stalled. So the line search only
   // backtracks (halving) from steps that make the forces non-finite; divergence is caught by the
   // iteration limit and answered by a smaller load step.
-  // target: the residual asked for; floor: what rounding alone leaves (rounding_floor). A
-  // residual below 10 floor that Newton no longer reduces is converged; a correction below the
-  // resolution of the coordinates with a residual above that means the loads push along a
-  // direction without stiffness, and is a failure, never an equilibrium.
-  bool solve(double factor, double target, double floor) {
-    double r = residual_at(factor), best = r;
-    int rising = 0, stalled = 0;
+  //
+  // Converged: the residual is below `target`, or it is at the rounding floor (eps |S| |x|) and
+  // the correction no longer moves the solution (below kCorrectionTolerance of it). A residual
+  // that stays at the floor while the corrections do not shrink is rounding-limited: the
+  // equilibrium cannot be resolved in double precision, and no load step helps.
+  bool solve(double factor, double target) {
+    double r = residual_at(factor);
+    if (!std::isfinite(r))
+      return fail(
+          "the forces are not finite (the loads or the stiffness overflow double precision)", true);
+    const std::vector<double> carriages = carriage_positions();
+    int rising = 0;
+    int noisy = 0;             // iterations in a row with the residual near its rounding floor
+    double noisy_first = 0.0;  // the correction at the first of them
     for (int it = 0; it < max_iterations; ++it) {
-      if (r <= target || (r <= 10.0 * floor && stalled >= 2)) {
+      if (r <= target) {
         residual = r;
         return true;
       }
+      if (budget.spent())
+        return fail("the static analysis did not finish within its time budget", true);
       compute_tangent(model, data, t, false, factor);
       const Eigen::VectorXd w = wrench_vector(model, data);
       ++iterations;
-      if (!solver.factorize(model, data, &failure)) return false;
+      std::string why;
+      if (!solver.factorize(model, data, &why)) return fail(why, false);
       singular = std::max(singular, solver.null_directions);
-      const Eigen::VectorXd dx = solver.solve(-w);
-      if (!dx.allFinite()) {
-        failure = "the tangent stiffness is singular";
-        return false;
-      }
+      Eigen::VectorXd dx = solver.solve(-w);
+      if (!dx.allFinite()) return fail("the tangent stiffness is singular", false);
       if (solver.null_directions > 0 && scaled_norm(solver.apply(dx) + w, length) >
-                                            std::max(1e-6 * scaled_norm(w, length), 10.0 * floor)) {
-        failure =
+                                            std::max(1e-6 * scaled_norm(w, length), 10.0 * floor))
+        return fail(
             "the loads push along a direction without stiffness (a free mechanism, such as a "
-            "carriage pushed along its rails): there is no equilibrium";
-        no_equilibrium = true;
-        return false;
+            "carriage pushed along its rails): there is no equilibrium",
+            true);
+      const Eigen::VectorXd x = displacement(model, data);
+      floor = solver.rounding_floor(x, length);
+      const double size = motion_size(x, length);
+      correction = size > 0.0 ? motion_size(dx, length) / size : INFINITY;
+      // At the rounding floor a correction this small is rounding noise: the last one is applied.
+      const bool converged = r <= 10.0 * floor && correction <= kCorrectionTolerance;
+      // At most kMaxRotationStep of rotation per body in one iterate.
+      double turn = 0.0;
+      for (int k = 0; k < model.n_free(); ++k)
+        turn = std::max(turn, dx.segment<3>(kDofsPerBody * k + 3).norm());
+      if (turn > kMaxRotationStep) dx *= kMaxRotationStep / turn;
+      if (converged) {
+        apply_increment(model, data, dx);
+        residual = residual_at(factor);
+        if (std::isfinite(residual)) return true;
+        return fail("the forces are not finite", false);
       }
-      if (size(dx) <= 1e-14 * length) {
-        residual = r;
-        if (r <= 10.0 * floor) return true;  // converged to rounding
-        failure =
-            "the loads cannot be balanced (the Newton correction vanishes while the residual "
-            "stays at " +
-            std::to_string(r) + " N)";
-        return false;
-      }
-      const std::vector<Pose<double>> pose = data.pose;
-      const std::vector<Vec4> q = data.q;
+      const Saved saved = save();
       const auto trial = [&](double fraction) {
-        data.pose = pose;
-        data.q = q;
+        restore(saved);
         apply_increment(model, data, fraction * dx);
         return residual_at(factor);
       };
@@ -229,48 +339,88 @@ struct Newton {
       for (double fraction = 0.5; !std::isfinite(value) && fraction > 1e-3; fraction *= 0.5)
         value = trial(fraction);
       if (!std::isfinite(value)) {
-        data.pose = pose;
-        data.q = q;
-        failure = "Newton steps lead to non-finite forces";
-        return false;
+        restore(saved);
+        return fail("Newton steps lead to non-finite forces", false);
       }
+      if (std::string away = runaway_carriage(carriages); !away.empty()) return fail(away, false);
+      if (std::string turned = element_turned_beyond(model, data, kIterateRotationLimit);
+          !turned.empty())
+        return fail(turned + " in a Newton iterate", false);
       rising = value > r ? rising + 1 : 0;
-      stalled = value < 0.5 * best ? 0 : stalled + 1;
-      best = std::min(best, value);
-      r = value;
-      if (rising >= 8) {
-        failure = "Newton diverges (the residual grew 8 times in a row)";
-        return false;
+      // Near the floor Newton converges in a few iterations (each correction a fraction of the
+      // previous one); corrections that keep their size there are moved by rounding alone.
+      if (r <= 1e3 * floor) {
+        noisy_first = noisy == 0 ? correction : noisy_first;
+        ++noisy;
+      } else {
+        noisy = 0;
       }
+      r = value;
+      if ((noisy >= 6 && correction > 1e-2 * noisy_first) || noisy >= 12)
+        return fail("rounding errors limit this equilibrium: the residual stays at " +
+                        format("%.3g N (rounding floor %.3g N)", r, floor) +
+                        format(" while the Newton corrections still move the solution by %.2g "
+                               "of its size; the stiffness terms of this scene cancel beyond "
+                               "double precision (chains of very many short segments): use "
+                               "fewer segments",
+                               correction),
+                    true);
+      if (rising >= 8) return fail("Newton diverges (the residual grew 8 times in a row)", false);
     }
     residual = r;
     if (r <= target) return true;
-    failure = "Newton did not converge in " + std::to_string(max_iterations) +
-              (max_iterations == 1 ? " iteration" : " iterations");
-    return false;
+    return fail("Newton did not converge in " + std::to_string(max_iterations) +
+                    (max_iterations == 1 ? " iteration" : " iterations"),
+                false);
   }
 };
+
+// Directions of negative stiffness at the equilibrium in data.pose: the negative pivots of an
+// LDL^T of the symmetric tangent (Sylvester's law of inertia), shifted by a small multiple of the
+// mass where rigid-body or mechanism directions (zero stiffness) may exist.
+int negative_directions(const Model& model, Data& data, double t) {
+  compute_tangent(model, data, t, false, 1.0);
+  const Eigen::SparseMatrix<double> s = stiffness_matrix(model, data);
+  Eigen::SparseMatrix<double> k = -0.5 * (s + Eigen::SparseMatrix<double>(s.transpose()));
+  if (!held_by_beams(model)) {
+    const Eigen::SparseMatrix<double> m = mass_matrix(model, data);
+    double scale = 0.0;
+    for (Eigen::Index i = 0; i < k.rows(); ++i)
+      scale = std::max(scale, std::abs(k.coeff(i, i)) / m.coeff(i, i));
+    k += (1e4 * kEps * (scale > 0.0 ? scale : 1.0)) * m;
+  }
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
+  if (ldlt.info() != Eigen::Success) return 1;  // a zero pivot: singular, not stable
+  return static_cast<int>((ldlt.vectorD().array() < 0.0).count());
+}
 
 }  // namespace
 
 StaticResult solve_static(const Model& model, const StaticOptions& options, Data& data) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   StaticResult result;
+  Budget budget;
+  if (options.max_seconds > 0.0) {
+    budget.active = true;
+    budget.end = start + std::chrono::duration_cast<Clock::duration>(
+                             std::chrono::duration<double>(options.max_seconds));
+  }
   try {
     reset_to_initial(model, data);
     const double length = characteristic_length(model);
     const double f_ref = reference_force(model, options.time, length);
     result.reference_force = f_ref;
+    if (!std::isfinite(f_ref))
+      throw std::runtime_error("the loads are out of the range of double precision");
     std::shared_ptr<const SparseStructure> structure;  // none without free bodies: nothing to solve
     if (model.n_free() > 0)
       structure = options.structure_cache ? options.structure_cache->get(model)
                                           : std::make_shared<const SparseStructure>(model);
-    Newton newton{model, data, options.time, length, options.max_iterations,
-                  0,     0,    0.0,          {},     TangentSolver(std::move(structure)),
-                  false};
-    const double floor = rounding_floor(model, data);
+    Newton newton(model, data, options.time, length, options.max_iterations, budget,
+                  std::move(structure));
 
-    double done = 0.0;  // load factor reached
+    // Without loads the initial configuration, stress-free by construction, is the equilibrium.
+    double done = f_ref > 0.0 && model.n_free() > 0 ? 0.0 : 1.0;
     double increment = options.load_steps > 0 ? 1.0 / options.load_steps : 1.0;
     const double min_increment = 1.0 / (1 << 20);
     while (done < 1.0) {
@@ -279,50 +429,67 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
         break;
       }
       const double factor = std::min(1.0, done + increment);
-      const std::vector<Pose<double>> pose = data.pose;
-      const std::vector<Vec4> q = data.q;
+      const Newton::Saved saved = newton.save();
       ++result.load_steps;
       newton.failure.clear();
-      if (newton.solve(factor, factor * options.tolerance * f_ref, floor)) {
+      if (newton.solve(factor, factor * options.tolerance * f_ref)) {
         done = factor;
         if (options.load_steps == 0) increment = std::min(1.0, 2.0 * increment);
         continue;
       }
       // Back to the last equilibrium with a smaller load increment (unless no increment can
-      // help: the loads have no equilibrium at all).
-      data.pose = pose;
-      data.q = q;
+      // help: no equilibrium, rounding, the budget).
+      newton.restore(saved);
       increment *= 0.5;
-      if (newton.no_equilibrium || increment < min_increment) {
-        char where[120];
-        std::snprintf(where, sizeof where, " (at load factor %.6g, %d load steps)", factor,
-                      result.load_steps);
-        result.message = newton.failure + where;
+      if (newton.final || increment < min_increment) {
+        result.message = newton.failure + format(" (at load factor %.6g, ", factor) +
+                         std::to_string(result.load_steps) +
+                         (result.load_steps == 1 ? " load step)" : " load steps)");
+        // An element near the end of its law's range explains most such failures.
+        if (std::string edge = element_out_of_range(model, data, 0.8 * kElementAngleLimit);
+            !edge.empty())
+          result.message = format("at load factor %.6g, ", done) + edge +
+                           "; beyond it the Newton iterations failed: " + result.message;
+        result.timed_out = budget.spent();
         break;
       }
     }
     result.ok = done >= 1.0;
-    if (result.ok && f_ref == 0.0) newton.residual = newton.residual_at(1.0);
     compute_wrenches(model, data, options.time, result.ok ? 1.0 : done);
     result.residual_norm = scaled_norm(wrench_vector(model, data), length);
     result.iterations = newton.iterations;
-    if (result.ok && !(result.residual_norm <= std::max(options.tolerance * f_ref, 10.0 * floor))) {
-      // Never an equilibrium that does not balance the loads.
-      result.ok = false;
-      char text[160];
-      std::snprintf(text, sizeof text, "the residual %.3g N does not balance the loads",
-                    result.residual_norm);
-      result.message = text;
-    }
-    if (result.ok && result.residual_norm > std::max(options.tolerance, 1e-6) * f_ref) {
-      char text[200];
-      std::snprintf(text, sizeof text,
-                    "rounding limited the static residual to %.3g N (%.3g of the load): stiff "
-                    "elements far from the origin",
-                    result.residual_norm, result.residual_norm / std::max(f_ref, 1e-300));
-      result.warnings.push_back(text);
-    }
+    result.rounding_floor = newton.floor;
+    result.correction = newton.correction;
     result.singular_directions = newton.singular;
+    if (result.ok && !std::isfinite(result.residual_norm)) {
+      result.ok = false;
+      result.message = "the forces are not finite at the equilibrium";
+    }
+    if (result.ok) {
+      if (std::string range = element_out_of_range(model, data); !range.empty()) {
+        result.ok = false;
+        result.message = range;
+      }
+    }
+    if (result.ok && model.n_free() > 0) {
+      result.negative_directions = negative_directions(model, data, options.time);
+      compute_wrenches(model, data, options.time, 1.0);
+      if (result.negative_directions > 0) {
+        result.ok = false;
+        result.message =
+            "the equilibrium found is unstable: its tangent stiffness has " +
+            std::to_string(result.negative_directions) +
+            " direction(s) of negative stiffness (the structure buckles under these loads; the "
+            "state found is the unbuckled one)";
+      }
+    }
+    if (result.ok && result.residual_norm > std::max(options.tolerance, 1e-6) * f_ref)
+      result.warnings.push_back(
+          format("rounding limits the balance of the forces to %.3g N (%.3g of the load): ",
+                 result.residual_norm, result.residual_norm / std::max(f_ref, 1e-300)) +
+          format("element forces (shear in very short segments) are uncertain by that much; the "
+                 "displacements are converged (last correction %.2g of them)",
+                 result.correction));
     if (newton.singular > 0)
       result.warnings.push_back(
           "the tangent stiffness has " + std::to_string(newton.singular) +
@@ -338,8 +505,7 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
   DeformationCheck deformation(model);
   deformation.observe(model, data, options.time);
   for (std::string& w : deformation.warnings(model, false)) result.warnings.push_back(std::move(w));
-  result.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return result;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <limits>
 
@@ -99,6 +100,13 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
         }
       }
       if (result.ok) deliver(t_out);
+      // An element outside the range of its law ends the run (checked at accepted states).
+      if (std::string range = element_out_of_range(model, data); result.ok && !range.empty()) {
+        result.ok = false;
+        char when[64];
+        std::snprintf(when, sizeof when, "at t = %.6g s, ", t_out);
+        result.message = when + range;
+      }
     }
     result.t_reached = t;
     result.stats = integrator->stats();

@@ -8,6 +8,7 @@ Data::Data(const Model& model)
     : pose(model.bodies.size()),
       q(model.bodies.size()),
       w(model.bodies.size()),
+      rotation(model.bodies.size(), Vec3::Zero()),
       wrench(model.bodies.size(), Vec6::Zero()),
       rail_floored(model.rails.size(), 0),
       rail_floored_ever(model.rails.size(), 0),
@@ -17,7 +18,7 @@ Data::Data(const Model& model)
     const Body& b = model.bodies[i];
     q[i] = b.orientation / b.orientation.norm();
     w[i] = b.fixed ? Vec3::Zero() : b.angular_velocity;
-    pose[i].c = b.position;
+    pose[i].u = Vec3::Zero();
     pose[i].A = rotation_matrix<double>(q[i]);
     pose[i].v = b.fixed ? Vec3::Zero() : b.velocity;
     pose[i].omega = pose[i].A * w[i];
@@ -29,7 +30,7 @@ void set_state(const Model& model, Data& data, const double* y) {
     const int i = model.free_bodies[k];
     const double* s = y + kStatesPerBody * k;
     Pose<double>& p = data.pose[i];
-    p.c = Vec3(s[0], s[1], s[2]);
+    p.u = Vec3(s[0], s[1], s[2]) - model.bodies[i].position;
     data.q[i] = Vec4(s[3], s[4], s[5], s[6]);
     p.A = rotation_matrix<double>(data.q[i]);
     p.v = Vec3(s[7], s[8], s[9]);

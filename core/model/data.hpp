@@ -15,6 +15,10 @@ struct Data {
   std::vector<Pose<double>> pose;  // per body (fixed bodies hold their initial pose)
   std::vector<Vec4> q;             // Euler parameters per body
   std::vector<Vec3> w;             // angular velocity in body axes per body [rad/s]
+  // Rotation vector of each body from its initial orientation, global axes [rad], followed
+  // continuously through pi (a body twisted by 7 rad reports 7 rad, not 7 - 2 pi). Kept by
+  // apply_increment and reset_to_initial (static analysis); other analyses leave it alone.
+  std::vector<Vec3> rotation;
 
   std::vector<Vec6> wrench;        // per body: force and moment about the centre, global [N, N m]
   double elastic_energy = 0.0;     // sum of element strain energies [J]
@@ -28,6 +32,11 @@ struct Data {
   long n_wrench_evaluations = 0;
   long n_tangent_evaluations = 0;
 };
+
+// The centre of mass of body i in global coordinates [m]: its reference position plus pose[i].u.
+inline Vec3 centre(const Model& model, const Data& data, int i) {
+  return model.bodies[i].position + data.pose[i].u;
+}
 
 // Sets pose, q and w of the free bodies from a state vector y (dim model.n_states).
 void set_state(const Model& model, Data& data, const double* y);

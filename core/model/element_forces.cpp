@@ -19,7 +19,7 @@ EndForces to_end_forces(const ElementFrames<double>& f, const Vec6& w1, const Ve
 }
 
 // Pose without velocities: end forces are the elastic forces only.
-Pose<double> at_rest(const Pose<double>& p) { return {p.c, p.A, Vec3::Zero(), Vec3::Zero()}; }
+Pose<double> at_rest(const Pose<double>& p) { return {p.u, p.A, Vec3::Zero(), Vec3::Zero()}; }
 
 }  // namespace
 

@@ -24,10 +24,16 @@
 
 namespace beamrail {
 
-// Position, orientation and velocity of a body, all in global axes.
+// Position, orientation and velocity of a body, all in global axes. The centre is held as its
+// displacement u from the body's reference position (in a Model: Body::position, the initial
+// centre), never as absolute coordinates: an element's chord is the difference of its bodies'
+// reference centres (ElementEnds::centre_offset, a constant) plus u2 - u1, which keeps the
+// precision of the displacements however far the bodies are from the origin. Absolute coordinates
+// would round the chord of a short element to eps |c|, which a stiff element turns into large
+// forces.
 template <class T>
 struct Pose {
-  Vec3T<T> c;      // centre of mass [m]
+  Vec3T<T> u;      // displacement of the centre of mass from the reference position [m]
   Mat3T<T> A;      // body -> global rotation
   Vec3T<T> v;      // velocity of the centre [m/s]
   Vec3T<T> omega;  // angular velocity, global axes [rad/s]
@@ -72,8 +78,7 @@ ElementFrames<T> element_frames(const ElementEnds& ends, const Pose<T>& b1, cons
   const Mat3T<T> e2 = b2.A * ends.frame2;
   f.R1 = b1.A * ends.r1;
   f.R2 = b2.A * ends.r2;
-  const Vec3T<T> p2 = b2.c + f.R2;
-  f.lever1 = p2 - b1.c;
+  f.lever1 = ends.centre_offset.template cast<T>() + (b2.u - b1.u) + f.R2;  // p2 - c1
   f.xi = f.E1.transpose() * (f.lever1 - f.R1);
   f.a = f.E1.transpose() * e2;
   relative_angles(f.a, twist_free_bending, f.phi, f.t);

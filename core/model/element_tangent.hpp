@@ -17,7 +17,7 @@ using Mat12 = Eigen::Matrix<double, 12, 12>;
 // derivative at theta = 0 needs.
 inline Pose<Ad12> seed_configuration(const Pose<double>& p, int offset) {
   Pose<Ad12> s;
-  for (int j = 0; j < 3; ++j) s.c(j) = Ad12(p.c(j), offset + j);
+  for (int j = 0; j < 3; ++j) s.u(j) = Ad12(p.u(j), offset + j);
   // d A / d theta_k = [e_k]x A: column j of it is e_k x A_j.
   for (int j = 0; j < 3; ++j) {
     const Vec3 col = p.A.col(j);
@@ -35,7 +35,7 @@ inline Pose<Ad12> seed_configuration(const Pose<double>& p, int offset) {
 // Pose whose velocities carry derivative seeds offset..offset+5 (v, omega).
 inline Pose<Ad12> seed_velocity(const Pose<double>& p, int offset) {
   Pose<Ad12> s;
-  s.c = p.c.cast<Ad12>();
+  s.u = p.u.cast<Ad12>();
   s.A = p.A.cast<Ad12>();
   for (int j = 0; j < 3; ++j) {
     s.v(j) = Ad12(p.v(j), offset + j);

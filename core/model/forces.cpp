@@ -135,7 +135,8 @@ double kinetic_energy(const Model& model, const Data& data) {
 
 double gravity_energy(const Model& model, const Data& data) {
   double e = 0.0;
-  for (int i : model.free_bodies) e -= model.bodies[i].mass * model.gravity.dot(data.pose[i].c);
+  for (int i : model.free_bodies)
+    e -= model.bodies[i].mass * model.gravity.dot(centre(model, data, i));
   return e;
 }
 

@@ -47,10 +47,13 @@ void apply_increment(const Model& model, Data& data, const Eigen::VectorXd& dx) 
     const int i = model.free_bodies[k];
     const Vec3 dc = dx.segment<3>(kDofsPerBody * k);
     const Vec3 dtheta = dx.segment<3>(kDofsPerBody * k + 3);
-    data.pose[i].c += dc;
+    data.pose[i].u += dc;
     data.q[i] = quat_multiply(quat_from_rotation_vector(dtheta), data.q[i]);
     data.q[i] /= data.q[i].norm();
     data.pose[i].A = rotation_matrix<double>(data.q[i]);
+    const Mat3 a0 = rotation_matrix<double>(model.bodies[i].orientation);
+    data.rotation[i] =
+        rotation_vector_near(data.pose[i].A * a0.transpose(), data.rotation[i] + dtheta);
   }
 }
 
@@ -59,7 +62,8 @@ void reset_to_initial(const Model& model, Data& data) {
     const Body& b = model.bodies[i];
     data.q[i] = b.orientation / b.orientation.norm();
     data.w[i].setZero();
-    data.pose[i] = {b.position, rotation_matrix<double>(data.q[i]), Vec3::Zero(), Vec3::Zero()};
+    data.rotation[i].setZero();
+    data.pose[i] = {Vec3::Zero(), rotation_matrix<double>(data.q[i]), Vec3::Zero(), Vec3::Zero()};
   }
 }
 

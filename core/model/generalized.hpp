@@ -20,7 +20,8 @@ Eigen::SparseMatrix<double> stiffness_matrix(const Model& model, const Data& dat
 // The mass matrix in these coordinates: blocks m I and A J A^T (n_dofs x n_dofs).
 Eigen::SparseMatrix<double> mass_matrix(const Model& model, const Data& data);
 
-// Moves the free bodies by dx: c += dc, q <- quat(dtheta) (x) q; updates pose (at rest).
+// Moves the free bodies by dx: c += dc, q <- quat(dtheta) (x) q; updates pose (at rest) and the
+// bodies' rotation vectors (data.rotation, followed through pi).
 void apply_increment(const Model& model, Data& data, const Eigen::VectorXd& dx);
 
 // Resets every free body to its initial pose, at rest.

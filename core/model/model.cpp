@@ -46,4 +46,20 @@ void Model::finalize() {
         couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
 }
 
+bool held_by_beams(const Model& model) {
+  std::vector<int> parent(model.bodies.size());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  const auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const Beam& e : model.beams) parent[root(e.ends.body1)] = root(e.ends.body2);
+  std::vector<char> grounded(model.bodies.size(), 0);
+  for (size_t i = 0; i < model.bodies.size(); ++i)
+    if (model.bodies[i].fixed) grounded[root(static_cast<int>(i))] = 1;
+  for (int i : model.free_bodies)
+    if (!grounded[root(i)]) return false;
+  return true;
+}
+
 }  // namespace beamrail

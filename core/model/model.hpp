@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,12 +31,13 @@ struct Body {
 
 // Where an element attaches to its two bodies; computed once at set-up (DESIGN.md §1).
 struct ElementEnds {
-  int body1 = 0, body2 = 0;        // body indices
-  Vec3 r1 = Vec3::Zero();          // point 1 in body-1 axes, from its centre of mass [m]
-  Vec3 r2 = Vec3::Zero();          // point 2 in body-2 axes [m]
-  Mat3 frame1 = Mat3::Identity();  // element frame in body-1 axes (A_bl_1)
-  Mat3 frame2 = Mat3::Identity();  // element frame in body-2 axes (A_bl_2)
-  double length = 0.0;             // |p2 - p1| in the initial configuration [m]
+  int body1 = 0, body2 = 0;           // body indices
+  Vec3 r1 = Vec3::Zero();             // point 1 in body-1 axes, from its centre of mass [m]
+  Vec3 r2 = Vec3::Zero();             // point 2 in body-2 axes [m]
+  Mat3 frame1 = Mat3::Identity();     // element frame in body-1 axes (A_bl_1)
+  Mat3 frame2 = Mat3::Identity();     // element frame in body-2 axes (A_bl_2)
+  Vec3 centre_offset = Vec3::Zero();  // c2 - c1 of the bodies' reference centres, global [m]
+  double length = 0.0;                // |p2 - p1| in the initial configuration [m]
 };
 
 // Which of the two force laws of DESIGN.md §1 an element uses.
@@ -73,7 +75,11 @@ struct Rail {
   double gj = 0.0;              // G Ix; 0 for cylindrical rails [N m^2]
   double eiy = 0.0, eiz = 0.0;  // [N m^2]
   double min_length = 0.0;      // floor of |l| [m]
-  double damping = 0.0;         // [s]
+  // The carriage's axial coordinate l (from point 1 along the rail's x) must stay within
+  // [travel_min, travel_max]: the rail's extent [m]; unbounded when not given.
+  double travel_min = -std::numeric_limits<double>::infinity();
+  double travel_max = std::numeric_limits<double>::infinity();
+  double damping = 0.0;  // [s]
   Formulation formulation = Formulation::kEnergy;
   SectionProperties section;
   double density = 0.0;
@@ -119,6 +125,10 @@ struct Model {
   // the scene loader after the element arrays are final.
   void finalize();
 };
+
+// True when every free body is joined through beams (which resist all six relative motions) to a
+// fixed body: the elastic stiffness is then positive definite (no rigid-body or mechanism mode).
+bool held_by_beams(const Model& model);
 
 constexpr int kStatesPerBody = 13;
 constexpr int kDofsPerBody = 6;

@@ -86,6 +86,26 @@ inline Vec3 rotation_vector(const Mat3& a) {
   return 2.0 * std::atan2(s, q(0)) / s * q.tail<3>();
 }
 
+// The rotation vector of a that is nearest `near` among its equivalents (angle + 2 pi k about the
+// same axis, any integer k): follows a rotation continuously through pi when `near` is the
+// previous rotation vector plus the increment since.
+inline Vec3 rotation_vector_near(const Mat3& a, const Vec3& near) {
+  constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+  const Vec3 r = rotation_vector(a);
+  double angle = r.norm();
+  Vec3 axis;
+  if (angle > 1e-12) {
+    axis = r / angle;
+  } else if (near.norm() > 0.5 * kTwoPi) {
+    axis = near.normalized();  // a whole number of turns about the axis of `near`
+    angle = 0.0;
+  } else {
+    return r;
+  }
+  const double turns = std::round((near.dot(axis) - angle) / kTwoPi);
+  return (angle + kTwoPi * turns) * axis;
+}
+
 // d(theta)/dq: the global rotation increment produced by a change dq of (unnormalized) Euler
 // parameters, theta = 2 vec(dq (x) q*) / |q|^2  (3 x 4).
 inline Mat34 rotation_increment_jacobian(const Vec4& q) {

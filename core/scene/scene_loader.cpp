@@ -151,6 +151,7 @@ ElementEnds make_ends(const ElementSpec& e, const std::vector<Body>& bodies) {
   ends.frame1 = a1.transpose() * frame;
   ends.frame2 = a2.transpose() * frame;
   ends.length = (e.p2 - e.p1).norm();
+  ends.centre_offset = b2.position - b1.position;
   return ends;
 }
 
@@ -268,6 +269,7 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
       r.eiy = modulus_e * e.section.iy;
       r.eiz = modulus_e * e.section.iz;
       r.min_length = e.min_length.value_or(1e-3 * ends.length);
+      if (e.travel) r.travel_min = (*e.travel)[0], r.travel_max = (*e.travel)[1];
       r.damping = e.damping;
       r.formulation = e.formulation;
       r.section = e.section;

@@ -1,6 +1,7 @@
 // Readers of the scene's materials, sections, bodies, beams, rails and loads.
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 
 #include "core/model/rotation.hpp"
 #include "core/model/section.hpp"
@@ -354,7 +355,23 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
     } else {
       e.segments = segments.value_or(0);
     }
-    if (rails) e.min_length = r.positive("min_length", false);
+    if (rails) {
+      e.min_length = r.positive("min_length", false);
+      e.travel = r.numbers("travel", false, 2);
+      if (e.travel && !((*e.travel)[0] < (*e.travel)[1])) {
+        r.error("travel", "must be [min, max] with min < max (metres along the rail from point 1)");
+        e.travel.reset();
+      } else if (e.travel && p1 && p2) {
+        const double l0 = (*p2 - *p1).norm();
+        if (!(l0 >= (*e.travel)[0] && l0 <= (*e.travel)[1])) {
+          char text[160];
+          std::snprintf(text, sizeof text,
+                        "the carriage starts at %.6g m from point 1, outside its travel", l0);
+          r.error("travel", text);
+          e.travel.reset();
+        }
+      }
+    }
     bool ok = name && b1 && b2 && p1 && p2 && p3 && material && section;
     if (name) {
       if (name->empty()) {

@@ -51,6 +51,7 @@ struct ElementSpec {
   Formulation formulation = Formulation::kEnergy;
   long segments = 0;  // at most kMaxSegments, all elements together
   std::optional<double> min_length;
+  std::optional<std::vector<double>> travel;  // rails: [min, max] of the carriage's coordinate
 };
 
 struct SceneSpecs {

@@ -20,8 +20,8 @@ Case make_case(Formulation f, double damping) {
   Case c;
   c.b1 = testing::pose(rng.vec3(1.0), rng.rotation());
   c.b2 = testing::pose(rng.vec3(1.0) + Vec3(2, 0, 0), rng.rotation());
-  c.beam.ends = testing::make_ends(c.b1.c + rng.vec3(0.2), c.b2.c + rng.vec3(0.2),
-                                   c.b1.c + rng.vec3(1.0), c.b1, c.b2);
+  c.beam.ends = testing::make_ends(c.b1.u + rng.vec3(0.2), c.b2.u + rng.vec3(0.2),
+                                   c.b1.u + rng.vec3(1.0), c.b1, c.b2);
   c.beam.ea = 2.1e7, c.beam.gj = 113, c.beam.eiy = 175, c.beam.eiz = 175;
   c.beam.formulation = f;
   c.beam.damping = damping;

@@ -29,7 +29,7 @@ TipPath run(const Model& model, const TransientOptions& options, TransientResult
   Data data(model);
   const int tip = tip_index(model);
   *result = run_transient(model, options, data, [&](const TransientSample&, const Data& d) {
-    path.tip.push_back(d.pose[tip].c);
+    path.tip.push_back(d.pose[tip].u);
   });
   return path;
 }

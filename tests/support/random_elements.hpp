@@ -39,8 +39,8 @@ inline ElementEnds make_ends(const Vec3& p1, const Vec3& p2, const Vec3& p3, con
   const Vec3 y = ((p3 - p1) - (p3 - p1).dot(x) * x).normalized();
   Mat3 frame;
   frame << x, y, x.cross(y);
-  e.r1 = b1.A.transpose() * (p1 - b1.c);
-  e.r2 = b2.A.transpose() * (p2 - b2.c);
+  e.r1 = b1.A.transpose() * (p1 - b1.u);
+  e.r2 = b2.A.transpose() * (p2 - b2.u);
   e.frame1 = b1.A.transpose() * frame;
   e.frame2 = b2.A.transpose() * frame;
   e.length = (p2 - p1).norm();
@@ -49,13 +49,13 @@ inline ElementEnds make_ends(const Vec3& p1, const Vec3& p2, const Vec3& p3, con
 
 // Applies the rigid motion x -> rot x + shift to a pose (velocities rotate with it).
 inline Pose<double> moved(const Pose<double>& p, const Mat3& rot, const Vec3& shift) {
-  return {rot * p.c + shift, rot * p.A, rot * p.v, rot * p.omega};
+  return {rot * p.u + shift, rot * p.A, rot * p.v, rot * p.omega};
 }
 
 // Rotates a pose by exp([theta]x) about its centre and shifts it by dc.
 inline Pose<double> perturbed(const Pose<double>& p, const Vec3& dc, const Vec3& theta) {
   const Mat3 r = rotation_matrix<double>(quat_from_rotation_vector(theta));
-  return {p.c + dc, r * p.A, p.v, p.omega};
+  return {p.u + dc, r * p.A, p.v, p.omega};
 }
 
 }  // namespace beamrail::testing

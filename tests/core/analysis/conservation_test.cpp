@@ -57,13 +57,13 @@ Momenta momenta(const Model& model, const Snapshot& s) {
   for (int i : model.free_bodies) {
     const double mi = model.bodies[i].mass;
     m += mi;
-    out.com += mi * s.pose[i].c;
+    out.com += mi * s.c[i];
     out.v_com += mi * s.pose[i].v;
   }
   out.com /= m, out.v_com /= m;
   for (int i : model.free_bodies) {
     const Body& b = model.bodies[i];
-    out.h += b.mass * (s.pose[i].c - out.com).cross(s.pose[i].v - out.v_com) +
+    out.h += b.mass * (s.c[i] - out.com).cross(s.pose[i].v - out.v_com) +
              s.pose[i].A * (b.inertia * s.w[i]);
   }
   return out;

@@ -19,6 +19,7 @@
 #include "core/model/element_kinematics.hpp"
 #include "core/model/rotation.hpp"
 #include "tests/support/run_process.hpp"
+#include "tests/support/scene_builder.hpp"
 #include "tests/support/transient_run.hpp"
 
 namespace beamrail {
@@ -29,62 +30,8 @@ using testing::TransientRun;
 
 constexpr double kE = 2.1e11, kG = 8.1e10, kPi = std::numbers::pi;
 
-Json vec(double x, double y, double z) { return Json::array({x, y, z}); }
-
-// A scene built in code; every element lies along global x unless told otherwise.
-struct Scene {
-  Json j = {{"materials", Json::object()}, {"sections", Json::object()}, {"bodies", Json::array()},
-            {"beams", Json::array()},      {"rails", Json::array()},     {"loads", Json::array()}};
-
-  Scene& material(const std::string& name, double e, double g) {
-    j["materials"][name] = {{"E", e}, {"G", g}};
-    return *this;
-  }
-  // A section given by its properties: S, torsion constant Ix, Iy, Iz.
-  Scene& custom(const std::string& name, double s, double ix, double iy, double iz) {
-    j["sections"][name] = {{"shape", "custom"}, {"S", s}, {"Ix", ix}, {"Iy", iy}, {"Iz", iz}};
-    return *this;
-  }
-  Scene& circle(const std::string& name, double d) {
-    j["sections"][name] = {{"shape", "circle"}, {"diameter", d}};
-    return *this;
-  }
-  Scene& square(const std::string& name, double a) {
-    j["sections"][name] = {{"shape", "rectangle"}, {"width", a}, {"height", a}};
-    return *this;
-  }
-  Scene& body(const std::string& name, double mass, const Vec3& inertia, const Vec3& position) {
-    j["bodies"].push_back({{"name", name},
-                           {"mass", mass},
-                           {"inertia", vec(inertia(0), inertia(1), inertia(2))},
-                           {"position", vec(position(0), position(1), position(2))}});
-    return *this;
-  }
-  Json& last_body() { return j["bodies"].back(); }
-  Scene& beam(const std::string& name, const std::string& b1, const std::string& b2, const Vec3& p1,
-              const Vec3& p2, const std::string& material, const std::string& section) {
-    j["beams"].push_back({{"name", name},
-                          {"body1", b1},
-                          {"body2", b2},
-                          {"point1", vec(p1(0), p1(1), p1(2))},
-                          {"point2", vec(p2(0), p2(1), p2(2))},
-                          {"point3", vec(p1(0), p1(1) + (p2 - p1).norm(), p1(2))},
-                          {"material", material},
-                          {"section", section}});
-    return *this;
-  }
-  Scene& force(const std::string& body, const Vec3& value) {
-    j["loads"].push_back(
-        {{"type", "force"}, {"body", body}, {"value", vec(value(0), value(1), value(2))}});
-    return *this;
-  }
-  Scene& torque(const std::string& body, const Vec3& value) {
-    j["loads"].push_back(
-        {{"type", "torque"}, {"body", body}, {"value", vec(value(0), value(1), value(2))}});
-    return *this;
-  }
-  Model model() const { return testing::scene_from_json(j.dump()); }
-};
+using testing::Scene;
+using testing::vec;
 
 using testing::body_index;
 
@@ -105,7 +52,7 @@ Equilibrium equilibrium(const Scene& scene, double tolerance = 1e-12) {
   options.tolerance = tolerance;
   e.result = solve_static(e.model, options, data);
   for (size_t i = 0; i < e.model.bodies.size(); ++i) {
-    e.displacement.push_back(data.pose[i].c - e.model.bodies[i].position);
+    e.displacement.push_back(data.pose[i].u);
     e.rotation.push_back(rotation_vector(data.pose[i].A));
   }
   return e;
@@ -375,7 +322,7 @@ TEST(Extremes, StiffnessRatiosBetweenNeighbouringBeams) {
     const int tip = body_index(model, "tip");
     for (const auto& s : run.samples) {
       t.push_back(s.sample.t);
-      x.push_back(s.pose[tip].c(1) - model.bodies[tip].position(1));
+      x.push_back(s.c[tip](1) - model.bodies[tip].position(1));
       drift = std::max(drift, std::abs(s.sample.energy() / e0 - 1));
     }
     EXPECT_LT(report("transient period of mode 1 [s]", mean_period(t, x), period), 1e-4);
@@ -494,14 +441,14 @@ TEST(Extremes, MassRatiosBetweenNeighbouringBodies) {
   const double e0 = run.samples.front().sample.energy();
   for (const auto& s : run.samples) {
     const double time = s.sample.t;
-    const Vec3 centre = (big * s.pose[1].c + m * s.pose[2].c) / (big + m);
+    const Vec3 centre = (big * s.c[1] + m * s.c[2]) / (big + m);
     const Vec3 expected = (m * Vec3(l, 0, 0) + p0 * time) / (big + m);
     if (time > 0)
       momentum = std::max(momentum, (centre - expected).norm() / (p0.norm() * time / (big + m)));
     drift = std::max(drift, std::abs(s.sample.energy() / e0 - 1));
     recoil = std::max(recoil, (s.pose[1].v - Vec3(0.2, 0.1, 0)).norm());
     t.push_back(time);
-    x.push_back(s.pose[2].c(0) - s.pose[1].c(0) - l);
+    x.push_back(s.c[2](0) - s.c[1](0) - l);
   }
   EXPECT_LT(report("free pair: period of the light body [s]", mean_period(t, x), period), 1e-6);
   std::printf(
@@ -654,7 +601,7 @@ TEST(Extremes, ThinRodBodyWithNearSingularInertia) {
   const double e0 = run.samples.front().sample.energy();
   for (const auto& q : run.samples) {
     t.push_back(q.sample.t);
-    x.push_back(q.pose[1].c(axis));
+    x.push_back(q.c[1](axis));
     drift = std::max(drift, std::abs(q.sample.energy() / e0 - 1));
   }
   EXPECT_LT(report("period of the lowest mode [s]", mean_period(t, x), period), 1e-5);
@@ -737,14 +684,14 @@ TEST(Extremes, CarriageDrivenThroughMinLengthAndOutTheOtherSide) {
     const double exact = t <= 1   ? 0.5 - t * t / 2
                          : t <= 2 ? -(t - 1) + (t - 1) * (t - 1) / 2
                                   : -0.5;
-    axial = std::max(axial, std::abs(q.pose[1].c(0) - exact));
+    axial = std::max(axial, std::abs(q.c[1](0) - exact));
   }
   const double ei = kE * 1e-8 / 12, p = 2.0 * 9.81, a = 0.5;
   std::printf("  %ld steps, %ld error-test failures; |x - x_exact| <= %.2e m\n",
               run.result.stats.steps, run.result.stats.error_test_failures, axial);
   for (const std::string& w : run.result.warnings) std::printf("  warning: %s\n", w.c_str());
   EXPECT_LT(axial, 1e-8);
-  EXPECT_LT(report("deflection at a = -0.5 m: P a^3/(3EI)", -run.samples.back().pose[1].c(1),
+  EXPECT_LT(report("deflection at a = -0.5 m: P a^3/(3EI)", -run.samples.back().c[1](1),
                    p * a * a * a / (3 * ei)),
             1e-6);
   EXPECT_TRUE(has_warning(run.result.warnings, "rail \"guide\" reached its min_length"));
@@ -760,7 +707,7 @@ TEST(Extremes, CarriageDrivenThroughMinLengthAndOutTheOtherSide) {
   double drift = 0;
   for (const auto& q : through.samples)
     drift = std::max(drift, std::abs(q.sample.energy() / e0 - 1));
-  const Vec3 end = through.samples.back().pose[1].c;
+  const Vec3 end = through.samples.back().c[1];
   std::printf("  energy law: at t = 6 s x = %.6f m (moved %.6f m), energy drift %.2e, %ld steps\n",
               end(0), end(0) - 0.5, drift, through.result.stats.steps);
   EXPECT_LT(drift, 1e-6);
@@ -924,7 +871,7 @@ ScaledAnswers solve_scaled(double l) {
       testing::simulate(e.model, testing::options(2 * period, period / 400, 1e-10, 1e-10 * l));
   EXPECT_TRUE(run.result.ok) << run.result.message;
   for (const auto& x : run.samples) {
-    const double y = x.pose[1].c(1) / l;
+    const double y = x.c[1](1) / l;
     if (y > a.peak) a.peak = y, a.peak_time = x.sample.t / l;
   }
   return a;

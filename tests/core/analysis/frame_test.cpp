@@ -286,7 +286,7 @@ Eigen::VectorXd static_solution(const Model& model, StaticResult* result) {
   Eigen::VectorXd x(model.n_dofs);
   for (int k = 0; k < model.n_free(); ++k) {
     const int b = model.free_bodies[k];
-    x.segment<3>(6 * k) = data.pose[b].c - model.bodies[b].position;
+    x.segment<3>(6 * k) = data.pose[b].u;
     x.segment<3>(6 * k + 3) = rotation_vector(
         Mat3(data.pose[b].A * rotation_matrix<double>(model.bodies[b].orientation).transpose()));
   }

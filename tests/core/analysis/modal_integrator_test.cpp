@@ -104,8 +104,8 @@ TEST(ModalIntegrator, AxialStepResponseIsExact) {
   double worst = 0.0;
   for (const auto& s : run.samples) {
     const double exact = amplitude * (1.0 - std::cos(w * s.sample.t));
-    worst = std::max(worst, std::abs(s.pose[m].c.x() - 1.0 - exact));
-    EXPECT_LT(s.pose[m].c.tail<2>().norm(), 1e-20);
+    worst = std::max(worst, std::abs(s.c[m].x() - 1.0 - exact));
+    EXPECT_LT(s.c[m].tail<2>().norm(), 1e-20);
   }
   std::printf(
       "axial step: worst error %.2e of amplitude %.2e (w = %.0f rad/s, %.1f periods), "
@@ -211,7 +211,7 @@ TEST(ModalIntegrator, FallsBackToTheInitialStateWithoutAnEquilibrium) {
   const int b = body_index(model, "puck");
   ASSERT_EQ(run.samples.size(), 11u);
   for (const auto& s : run.samples)
-    EXPECT_NEAR(s.pose[b].c.x(), 0.75 * s.sample.t * s.sample.t, 1e-14) << s.sample.t;
+    EXPECT_NEAR(s.c[b].x(), 0.75 * s.sample.t * s.sample.t, 1e-14) << s.sample.t;
 }
 
 // A tip torque that twists the cantilever's equilibrium 1.5 rad (GJ = 114 N m^2): too far to

@@ -44,8 +44,8 @@ TEST(RailMotion, AxialPushSlidesTheCarriageWithNoReaction) {
       double worst = 0, lateral = 0;
       for (const auto& s : run.samples) {
         const double t = s.sample.t;
-        worst = std::max(worst, std::abs(s.pose[1].c(0) - (0.5 + 0.75 * t * t)));
-        lateral = std::max(lateral, s.pose[1].c.tail<2>().norm());
+        worst = std::max(worst, std::abs(s.c[1](0) - (0.5 + 0.75 * t * t)));
+        lateral = std::max(lateral, s.c[1].tail<2>().norm());
       }
       std::printf("%s/%s: axial push over 1 s: |x - x_exact| <= %.2e m, lateral drift %.2e m\n",
                   type.c_str(), formulation.c_str(), worst, lateral);
@@ -64,13 +64,13 @@ TEST(RailMotion, LateralLoadDeflectsByCantileverFormulaAtAnyDistance) {
           type, "paper", a, "[0, -5, 0]", 0.05, R"({"type": "ramp", "from": 0, "to": 0.5})"));
       const TransientRun run = testing::simulate(model, testing::options(6.0, 0.1, 1e-10, 1e-14));
       ASSERT_TRUE(run.result.ok) << run.result.message;
-      const double deflection = -run.samples.back().pose[1].c(1);
+      const double deflection = -run.samples.back().c[1](1);
       const double exact = p * a * a * a / (3 * e * i);
       std::printf(
           "%s, a = %.1f m: deflection %.10e m, P a^3/(3EI) = %.10e m, relative error %.2e\n",
           type.c_str(), a, deflection, exact, deflection / exact - 1);
       EXPECT_NEAR(deflection / exact, 1.0, 1e-6);
-      EXPECT_NEAR(run.samples.back().pose[1].c(0), a, 1e-12 * a);  // still at distance a
+      EXPECT_NEAR(run.samples.back().c[1](0), a, 1e-12 * a);  // still at distance a
     }
 }
 

@@ -42,7 +42,7 @@ Solution solve(const Model& model, Data& data) {
   Solution s;
   s.result = solve_static(model, options, data);
   const int c = model.free_bodies[0];
-  s.displacement = data.pose[c].c - model.bodies[c].position;
+  s.displacement = data.pose[c].u;
   s.rotation = rotation_vector(data.pose[c].A);
   return s;
 }

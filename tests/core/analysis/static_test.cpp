@@ -47,7 +47,7 @@ Equilibrium solve(const std::string& json) {
   Equilibrium e;
   e.result = solve_static(model, options, data);
   const int tip = model.free_bodies[0];
-  e.displacement = data.pose[tip].c - model.bodies[tip].position;
+  e.displacement = data.pose[tip].u;
   e.rotation = rotation_vector(data.pose[tip].A);
   return e;
 }
@@ -144,7 +144,7 @@ TEST(Static, LongChainsAreNotMistakenForMechanisms) {
     ASSERT_TRUE(r.ok) << segments << ": " << r.message;
     EXPECT_EQ(r.singular_directions, 0);
     const int tip = model.free_bodies[0];
-    const double deflection = model.bodies[tip].position.y() - data.pose[tip].c.y();
+    const double deflection = -data.pose[tip].u.y();
     std::printf("%d segments: %d iterations, tip deflection %.10e, linear %.10e\n", segments,
                 r.iterations, deflection, closed);
     // Short of the linear deflection by (deflection / l)^2 = 3.6e-6, to 10 % of that.

@@ -69,7 +69,7 @@ TEST(Transient, BendingPeriodOfTipBodyMatchesClosedForm) {
   o.integrator.max_order = 2;
   const TransientRun run = testing::simulate(model, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;
-  const double measured = period(run, [](const Snapshot& s) { return s.pose[1].c(1); });
+  const double measured = period(run, [](const Snapshot& s) { return s.c[1](1); });
   std::printf(
       "bending period: measured %.12f s, closed form %.12f s, relative error %.2e (%ld steps)\n",
       measured, exact, measured / exact - 1, run.result.stats.steps);
@@ -83,7 +83,7 @@ TEST(Transient, AxialPeriodOfTipBodyMatchesClosedForm) {
   const TransientRun run =
       testing::simulate(model, testing::options(20 * exact, exact / 2000, 1e-11, 1e-15));
   ASSERT_TRUE(run.result.ok) << run.result.message;
-  const double measured = period(run, [](const Snapshot& s) { return s.pose[1].c(0) - 1.0; });
+  const double measured = period(run, [](const Snapshot& s) { return s.c[1](0) - 1.0; });
   std::printf("axial period: measured %.12f s, closed form %.12f s, relative error %.2e\n",
               measured, exact, measured / exact - 1);
   EXPECT_NEAR(measured / exact, 1.0, 1e-6);

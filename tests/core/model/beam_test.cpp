@@ -34,8 +34,8 @@ BeamCase random_case(Random& rng, Formulation formulation, double damping = 0.0)
   BeamCase s;
   s.b1 = testing::pose(rng.vec3(1.0), rng.rotation());
   s.b2 = testing::pose(rng.vec3(1.0) + Vec3(2, 0, 0), rng.rotation());
-  const Vec3 p1 = s.b1.c + rng.vec3(0.2);
-  const Vec3 p2 = s.b2.c + rng.vec3(0.2);
+  const Vec3 p1 = s.b1.u + rng.vec3(0.2);
+  const Vec3 p2 = s.b2.u + rng.vec3(0.2);
   const Vec3 p3 = p1 + rng.vec3(1.0);
   s.beam.ends = testing::make_ends(p1, p2, p3, s.b1, s.b2);
   const double e = 2.1e11 * rng.uniform(0.5, 1.5), g = 8.1e10 * rng.uniform(0.5, 1.5);
@@ -97,10 +97,10 @@ TEST(Beam, EnergyFormulationConservesAngularMomentumExactly) {
     BeamCase s = random_case(rng, Formulation::kEnergy);
     deform(rng, s, 3e-2);
     const Wrenches w = evaluate(s.beam, s.b1, s.b2);
-    const Vec3 total = s.b1.c.cross(w.w1.head<3>()) + w.w1.tail<3>() +
-                       s.b2.c.cross(w.w2.head<3>()) + w.w2.tail<3>();
+    const Vec3 total = s.b1.u.cross(w.w1.head<3>()) + w.w1.tail<3>() +
+                       s.b2.u.cross(w.w2.head<3>()) + w.w2.tail<3>();
     const double scale = w.w1.tail<3>().norm() + w.w2.tail<3>().norm() +
-                         (s.b1.c.norm() + s.b2.c.norm()) * w.w1.head<3>().norm();
+                         (s.b1.u.norm() + s.b2.u.norm()) * w.w1.head<3>().norm();
     EXPECT_LT(total.norm() / scale, 1e-12);
   }
 }
@@ -116,8 +116,8 @@ TEST(Beam, RigidMotionOfBothBodiesGivesNoForce) {
       const Vec3 omega = rng.vec3(10.0), v0 = rng.vec3(3.0);
       Pose<double> b1 = testing::moved(s.b1, rot, shift), b2 = testing::moved(s.b2, rot, shift);
       b1.omega = b2.omega = omega;
-      b1.v = v0 + omega.cross(b1.c);
-      b2.v = v0 + omega.cross(b2.c);
+      b1.v = v0 + omega.cross(b1.u);
+      b2.v = v0 + omega.cross(b2.u);
       const Wrenches w = evaluate(s.beam, b1, b2);
       // Forces that a strain of 1e-12 would cause.
       const double tiny = 1e-12 * s.beam.ea;

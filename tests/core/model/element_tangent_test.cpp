@@ -24,8 +24,8 @@ TEST(ElementTangent, ClosedFormJacobianEqualsAutomaticDifferentiation) {
       for (int i = 0; i < 100; ++i) {
         const Pose<double> b1 = testing::pose(rng.vec3(1.0), rng.rotation());
         Pose<double> b2 = testing::pose(rng.vec3(1.0) + Vec3(2, 0, 0), rng.rotation());
-        const ElementEnds ends = testing::make_ends(b1.c + rng.vec3(0.2), b2.c + rng.vec3(0.2),
-                                                    b1.c + rng.vec3(1.0), b1, b2);
+        const ElementEnds ends = testing::make_ends(b1.u + rng.vec3(0.2), b2.u + rng.vec3(0.2),
+                                                    b1.u + rng.vec3(1.0), b1, b2);
         // Deformations up to a few hundredths (rotations 0.05 rad): geometric terms matter.
         b2 = testing::perturbed(b2, rng.vec3(2e-2), rng.vec3(5e-2));
         Mat12 ad, closed;

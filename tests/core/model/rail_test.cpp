@@ -46,8 +46,8 @@ RailCase random_case(Random& rng, RailType type, Formulation formulation, double
   RailCase s;
   s.b1 = testing::pose(rng.vec3(1.0), rng.rotation());
   s.b2 = testing::pose(rng.vec3(1.0) + Vec3(2, 0, 0), rng.rotation());
-  const Vec3 p1 = s.b1.c + rng.vec3(0.2);
-  const Vec3 p2 = s.b2.c + rng.vec3(0.2);
+  const Vec3 p1 = s.b1.u + rng.vec3(0.2);
+  const Vec3 p2 = s.b2.u + rng.vec3(0.2);
   const Vec3 p3 = p1 + rng.vec3(1.0);
   s.rail.ends = testing::make_ends(p1, p2, p3, s.b1, s.b2);
   s.rail.type = type;
@@ -72,7 +72,7 @@ ElementFrames<double> frames(const RailCase& s) { return frames(s.rail, s.b1, s.
 // Slides the carriage along the rail (the x axis of the left-end frame) until xi_x = length.
 void slide_to(RailCase& s, double length) {
   const ElementFrames<double> f = frames(s);
-  s.b2.c += (length - f.xi(0)) * f.E1.col(0);
+  s.b2.u += (length - f.xi(0)) * f.E1.col(0);
 }
 
 // A random current length in [-1.5, 2] times the initial one, either side of point 1, with
@@ -103,7 +103,7 @@ void deform(Random& rng, RailCase& s, double size) {
 // Rotates a pose by exp([axis_angle]x) about a fixed point.
 Pose<double> turned(const Pose<double>& p, const Vec3& point, const Vec3& axis_angle) {
   const Mat3 r = rotation_matrix<double>(quat_from_rotation_vector(axis_angle));
-  return {point + r * (p.c - point), r * p.A, p.v, p.omega};
+  return {point + r * (p.u - point), r * p.A, p.v, p.omega};
 }
 
 // The force that a lateral deflection of 1e-12 |l| (or an end rotation of 1e-12 rad) would cause
@@ -182,8 +182,8 @@ TEST(Rail, RigidMotionAndSlidingAlongTheRailGiveNoForce) {
       s.b1 = testing::moved(s.b1, rot, shift);
       s.b2 = testing::moved(s.b2, rot, shift);
       s.b1.omega = s.b2.omega = omega;
-      s.b1.v = v0 + omega.cross(s.b1.c);
-      s.b2.v = v0 + omega.cross(s.b2.c);
+      s.b1.v = v0 + omega.cross(s.b1.u);
+      s.b2.v = v0 + omega.cross(s.b2.u);
       // Figure: largest wrench component over the yardstick (moments with a 10 m lever).
       const auto figure = [&s](const Wrenches& w, double l) {
         const double f = tiny_force(s.rail, l);
@@ -197,7 +197,7 @@ TEST(Rail, RigidMotionAndSlidingAlongTheRailGiveNoForce) {
       // Slide the carriage (also through point 1) and give it a sliding speed along the rail.
       const double l = random_length(rng, s.rail.ends.length);
       slide_to(s, l);
-      s.b2.v = v0 + omega.cross(s.b2.c) + rng.uniform(-5.0, 5.0) * frames(s).E1.col(0);
+      s.b2.v = v0 + omega.cross(s.b2.u) + rng.uniform(-5.0, 5.0) * frames(s).E1.col(0);
       const Wrenches slid = evaluate(s.rail, s.b1, s.b2);
       ASSERT_FALSE(slid.floored);
       EXPECT_NEAR(frames(s).xi(0), l, 1e-12);
@@ -286,7 +286,7 @@ TEST(Rail, CylindricalRailTransmitsNoTorsion) {
       const ElementFrames<double> fr = frames(s);
       const double l = std::abs(fr.xi(0));
       const double alpha = rng.uniform(-1.5, 1.5);  // up to 86 degrees either way
-      const Vec3 point = s.b2.c + fr.R2;
+      const Vec3 point = s.b2.u + fr.R2;
       const Pose<double> b2 = turned(s.b2, point, alpha * fr.E1.col(0));
       const Wrenches w = evaluate(s.rail, s.b1, b2);
       const double yard = tiny_force(s.rail, l);
@@ -325,7 +325,7 @@ TEST(Rail, CylindricalRailCarriageTurnsFreelyThroughAFullTurn) {
       const ElementFrames<double> fr = frames(s);
       const double l = std::abs(fr.xi(0));
       const double alpha = rng.uniform(-std::numbers::pi, std::numbers::pi);
-      const Pose<double> b2 = turned(s.b2, s.b2.c + fr.R2, alpha * fr.E1.col(0));
+      const Pose<double> b2 = turned(s.b2, s.b2.u + fr.R2, alpha * fr.E1.col(0));
       const Wrenches w = evaluate(s.rail, s.b1, b2);
       const double yard = tiny_force(s.rail, l);
       worst = std::max({worst, w.w1.head<3>().norm() / yard, w.w2.head<3>().norm() / yard,
@@ -348,7 +348,7 @@ TEST(Rail, CylindricalRailBendingIsIndependentOfTheCarriageTurn) {
       RailCase s = random_case(rng, RailType::kCylindrical, f, 0.0);
       deform(rng, s, 1e-3);
       const ElementFrames<double> fr = frames(s);
-      const Vec3 point = s.b2.c + fr.R2;
+      const Vec3 point = s.b2.u + fr.R2;
       const Vec3 bore = fr.E1 * fr.a.col(0);  // the carriage's own x axis (E2 x)
       const Pose<double> b2 = turned(s.b2, point, rng.uniform(-1.0, 1.0) * bore);
       const Wrenches w0 = evaluate(s.rail, s.b1, s.b2), w = evaluate(s.rail, s.b1, b2);

@@ -1,0 +1,77 @@
+#include "core/analysis/element_deformation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/model/element_kinematics.hpp"
+#include "core/model/rotation.hpp"
+
+namespace beamrail {
+namespace {
+
+// The 6 x 12 map from (dc1, dtheta1, dc2, dtheta2) to (d xi, d phi).
+Eigen::Matrix<double, 6, 12> kinematic_map(const ElementFrames<double>& f) {
+  const Mat3 et = f.E1.transpose();
+  Eigen::Matrix<double, 6, 12> j = Eigen::Matrix<double, 6, 12>::Zero();
+  j.block<3, 3>(0, 0) = -et;
+  j.block<3, 3>(0, 3) = et * skew<double>(f.lever1);
+  j.block<3, 3>(0, 6) = et;
+  j.block<3, 3>(0, 9) = -et * skew<double>(f.R2);
+  const Mat3 tet = f.t * et;
+  j.block<3, 3>(3, 3) = -tet;
+  j.block<3, 3>(3, 9) = tet;
+  return j;
+}
+
+}  // namespace
+
+ElementDeformation::ElementDeformation(const Model& model, const Data& data) {
+  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+  const auto extend = [&](const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  };
+  for (int i : model.free_bodies) extend(centre(model, data, i));
+  const auto add = [&](const ElementEnds& ends, bool rail, bool twist_free) {
+    const ElementFrames<double> f =
+        element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], twist_free);
+    const Vec3 c1 = centre(model, data, ends.body1);
+    extend(c1 + f.R1);
+    extend(c1 + f.lever1);
+    Row row;
+    row.k1 = model.bodies[ends.body1].free_index;
+    row.k2 = model.bodies[ends.body2].free_index;
+    if (row.k1 < 0 && row.k2 < 0) return;
+    row.j = kinematic_map(f);
+    row.counts = {!rail, true, true, !twist_free, true, true};
+    rows_.push_back(row);
+  };
+  for (const Beam& e : model.beams) add(e.ends, false, false);
+  for (const Rail& e : model.rails) add(e.ends, true, e.type == RailType::kCylindrical);
+  const double extent = model.n_free() > 0 ? (hi - lo).norm() : 0.0;
+  length_ = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
+}
+
+double ElementDeformation::ratio(const Eigen::VectorXd& x) const {
+  double motion = 0.0;
+  for (Eigen::Index k = 0; k < x.size() / kDofsPerBody; ++k)
+    motion = std::max(motion, x.segment<3>(kDofsPerBody * k).norm() / length_ +
+                                  x.segment<3>(kDofsPerBody * k + 3).norm());
+  if (motion == 0.0) return 0.0;
+  double worst = 0.0;
+  for (const Row& r : rows_) {
+    Eigen::Matrix<double, 12, 1> local = Eigen::Matrix<double, 12, 1>::Zero();
+    if (r.k1 >= 0) local.head<6>() = x.segment<kDofsPerBody>(kDofsPerBody * r.k1);
+    if (r.k2 >= 0) local.tail<6>() = x.segment<kDofsPerBody>(kDofsPerBody * r.k2);
+    const Vec6 d = r.j * local;
+    double xi = 0.0, phi = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      if (r.counts[c]) xi += d(c) * d(c);
+      if (r.counts[3 + c]) phi += d(3 + c) * d(3 + c);
+    }
+    worst = std::max(worst, std::sqrt(xi) / length_ + std::sqrt(phi));
+  }
+  return worst / motion;
+}
+
+}  // namespace beamrail

@@ -15,6 +15,7 @@
 #include "optimizer/batch_table.hpp"
 #include "optimizer/designs.hpp"
 #include "optimizer/interruption.hpp"
+#include "optimizer/nlopt_setup.hpp"
 #include "optimizer/progress.hpp"
 #include "optimizer/sampling.hpp"
 #include "optimizer/summary.hpp"
@@ -32,29 +33,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool needs_gradient(const std::string& algorithm) {
   return algorithm.size() > 2 && algorithm[1] == 'D';
-}
-
-bool handles_constraints(nlopt_algorithm a) {
-  switch (a) {
-    case NLOPT_LN_COBYLA:
-    case NLOPT_LD_MMA:
-    case NLOPT_LD_CCSAQ:
-    case NLOPT_LD_SLSQP:
-    case NLOPT_GN_ISRES:
-    case NLOPT_GN_ORIG_DIRECT:
-    case NLOPT_GN_ORIG_DIRECT_L:
-    case NLOPT_GN_AGS:
-    case NLOPT_AUGLAG:
-    case NLOPT_LN_AUGLAG:
-    case NLOPT_LD_AUGLAG:
-      return true;
-    default:
-      return false;
-  }
-}
-
-bool needs_local_optimizer(nlopt_algorithm a) {
-  return a == NLOPT_AUGLAG || a == NLOPT_AUGLAG_EQ || a == NLOPT_G_MLSL || a == NLOPT_G_MLSL_LDS;
 }
 
 std::string one_line(std::string s) {
@@ -315,44 +293,14 @@ std::vector<Design> Optimization::start_points() const {
 }
 
 void Optimization::run_start(Start& start, const Design& x0) {
-  const unsigned n = static_cast<unsigned>(variables_.size());
-  const nlopt_algorithm algorithm = nlopt_algorithm_from_string(plan_.algorithm.c_str());
-  const bool gradient = needs_gradient(plan_.algorithm);
-  std::vector<nlopt_opt> owned;
-  const auto local_optimizer = [&](nlopt_opt outer, nlopt_algorithm a) {
-    nlopt_opt local = nlopt_create(a, n);
-    nlopt_set_xtol_rel(local, plan_.xtol_rel);
-    nlopt_set_ftol_rel(local, plan_.ftol_rel);
-    nlopt_set_local_optimizer(outer, local);
-    owned.push_back(local);
-  };
-  nlopt_opt opt = nullptr;
-  if (!plan_.constraints.empty() && !handles_constraints(algorithm)) {
-    // Algorithms without constraint support run inside an augmented Lagrangian.
-    opt = nlopt_create(gradient ? NLOPT_LD_AUGLAG : NLOPT_LN_AUGLAG, n);
-    local_optimizer(opt, algorithm);
-  } else {
-    opt = nlopt_create(algorithm, n);
-    if (needs_local_optimizer(algorithm) || plan_.algorithm.find("MLSL") != std::string::npos) {
-      const std::string name = !plan_.local_algorithm.empty() ? plan_.local_algorithm
-                               : gradient                     ? "LD_MMA"
-                                                              : "LN_COBYLA";
-      local_optimizer(opt, nlopt_algorithm_from_string(name.c_str()));
-    }
-  }
-  owned.push_back(opt);
-  std::vector<double> lower, upper;
-  for (const DesignVariable& v : variables_) lower.push_back(v.lower), upper.push_back(v.upper);
-  nlopt_set_lower_bounds(opt, lower.data());
-  nlopt_set_upper_bounds(opt, upper.data());
+  const NloptSetup setup(plan_, variables_);
+  nlopt_opt opt = setup.get();
   nlopt_set_min_objective(opt, objective_callback, &start);
   std::vector<ConstraintRef> refs;
   for (size_t j = 0; j < plan_.constraints.size(); ++j)
     refs.push_back(ConstraintRef{&start, static_cast<int>(j)});
   for (ConstraintRef& ref : refs)
     nlopt_add_inequality_constraint(opt, constraint_callback, &ref, 1e-8);
-  nlopt_set_xtol_rel(opt, plan_.xtol_rel);
-  nlopt_set_ftol_rel(opt, plan_.ftol_rel);
   nlopt_set_maxeval(opt, plan_.max_evaluations);
   if (plan_.max_seconds > 0) nlopt_set_maxtime(opt, plan_.max_seconds);
   nlopt_srand(plan_.seed + static_cast<unsigned long>(start.index));  // stochastic algorithms
@@ -363,7 +311,6 @@ void Optimization::run_start(Start& start, const Design& x0) {
   start.result = nlopt_optimize(opt, x.data(), &f);
   if (start.result < 0 && nlopt_get_errmsg(opt)) start.message = nlopt_get_errmsg(opt);
   start.opt = nullptr;
-  for (nlopt_opt o : owned) nlopt_destroy(o);
 }
 
 // What a start's NLopt result means for the study: "" (a normal stop), or a warning, or an error.
@@ -424,6 +371,7 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
   s["beamrail_version"] = kVersion;
   s["type"] = "optimize";
   s["algorithm"] = plan_.algorithm;
+  s["optimizer"] = NloptSetup(plan_, variables_).description();
   s["status"] = status;
   s["message"] = message;
   s["warnings"] = warnings;

@@ -258,6 +258,9 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
   p.starts = static_cast<int>(std::min(r.integer("starts", false, 1).value_or(1), 100000L));
   p.seed = static_cast<unsigned long>(r.integer("seed", false, 0).value_or(1));
   p.gradient_step = r.positive("gradient_step", false).value_or(p.gradient_step);
+  if (const auto w = r.choice("warned_designs", false, {"infeasible", "accept"}))
+    p.warned_designs = *w == "accept" ? OptimizePlan::WarnedDesigns::kAccept
+                                      : OptimizePlan::WarnedDesigns::kInfeasible;
 }
 
 void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
@@ -339,6 +342,7 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
                "atol_scale",
                "reference",
                "target_error",
+               "warned_designs",
                "max_seconds_per_design"});
       return std::nullopt;
     }

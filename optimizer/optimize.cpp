@@ -35,12 +35,6 @@ bool needs_gradient(const std::string& algorithm) {
   return algorithm.size() > 2 && algorithm[1] == 'D';
 }
 
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  return s;
-}
-
 struct Record {
   int start = 0, evaluation = 0;
   Design x;
@@ -77,6 +71,9 @@ class Optimization {
     int j;
   };
 
+  // An evaluated design the optimization may use: ok, and without warnings unless they are
+  // accepted ("warned_designs").
+  bool usable(const DesignOutcome& o) const;
   double objective_of(const DesignOutcome& o) const;
   double constraint_of(const DesignOutcome& o, int j) const;
   bool feasible(const DesignOutcome& o) const;
@@ -114,8 +111,13 @@ class Optimization {
 // Whether the optimization must end now: a stop was requested or history.csv cannot be written.
 bool must_stop(const std::atomic<bool>& write_failed) { return stop_requested() || write_failed; }
 
+bool Optimization::usable(const DesignOutcome& o) const {
+  return o.status == "ok" &&
+         (o.warnings == 0 || plan_.warned_designs == OptimizePlan::WarnedDesigns::kAccept);
+}
+
 double Optimization::objective_of(const DesignOutcome& o) const {
-  if (o.status != "ok") return kPenalty;
+  if (!usable(o)) return kPenalty;
   double f = 0.0;
   switch (plan_.goal) {
     case OptimizePlan::Goal::kMinimize:
@@ -137,7 +139,7 @@ double Optimization::objective_of(const DesignOutcome& o) const {
 double Optimization::constraint_of(const DesignOutcome& o, int j) const {
   const Constraint& c = plan_.constraints[j];
   const double r = o.responses[c.response];
-  if (o.status != "ok" || !std::isfinite(r)) return kPenalty;
+  if (!usable(o) || !std::isfinite(r)) return kPenalty;
   const double scale = c.bound != 0.0 ? std::abs(c.bound) : 1.0;
   switch (c.kind) {
     case Constraint::Kind::kAtLeast:
@@ -150,7 +152,7 @@ double Optimization::constraint_of(const DesignOutcome& o, int j) const {
 }
 
 bool Optimization::feasible(const DesignOutcome& o) const {
-  if (o.status != "ok" || objective_of(o) >= kPenalty) return false;
+  if (!usable(o) || objective_of(o) >= kPenalty) return false;
   for (size_t j = 0; j < plan_.constraints.size(); ++j)
     if (!(constraint_of(o, static_cast<int>(j)) <= kFeasibility)) return false;
   return true;
@@ -163,8 +165,9 @@ CsvRow Optimization::row(const Record& r) const {
   out.push_back(format_number(r.objective));
   out.push_back(r.feasible ? "1" : "0");
   out.push_back(r.outcome.status);
+  out.push_back(std::to_string(r.outcome.warnings));
   out.push_back(format_number(r.outcome.wall_seconds));
-  out.push_back(one_line(r.outcome.message));
+  out.push_back(r.outcome.message);
   return out;
 }
 
@@ -363,6 +366,12 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
   } else {
     status = "infeasible";
     message = "no evaluated design satisfies every constraint";
+    long warned = 0;
+    for (const Record& r : records_) warned += r.outcome.status == "ok" && r.outcome.warnings > 0;
+    if (warned > 0 && plan_.warned_designs == OptimizePlan::WarnedDesigns::kInfeasible)
+      message += " (" + std::to_string(warned) +
+                 " designs with warnings count as infeasible; their warnings are in the message "
+                 "column of history.csv; \"warned_designs\": \"accept\" accepts them)";
   }
 
   nlohmann::json s;
@@ -384,6 +393,11 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
   s["starts"] = per_start;
   s["designs_simulated"] = simulated_.load();
   s["designs_failed"] = failures_.load();
+  long warned = 0;
+  for (const Record& r : records_) warned += r.outcome.warnings > 0;
+  s["designs_with_warnings"] = warned;
+  s["warned_designs"] =
+      plan_.warned_designs == OptimizePlan::WarnedDesigns::kAccept ? "accept" : "infeasible";
   s["designs_in_history"] = records_.size();
   s["threads"] = threads_;
   s["wall_seconds"] = wall;
@@ -438,7 +452,7 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
     return interrupted_exit_status(signal);
   }
   if (!best) {
-    std::cerr << "beamrail: " << study_.name << ": no feasible design found (" << records_.size()
+    std::cerr << "beamrail: " << study_.name << ": " << message << " (" << records_.size()
               << " designs evaluated); see " << history << "\n";
     return 1;
   }
@@ -455,7 +469,7 @@ int Optimization::run() {
   CsvRow header{"start", "evaluation"};
   for (const DesignVariable& v : variables_) header.push_back(v.name);
   for (const ResponseSpec& r : study_.responses) header.push_back(r.name);
-  for (const char* c : {"objective", "feasible", "status", "wall_s", "message"})
+  for (const char* c : {"objective", "feasible", "status", "warnings", "wall_s", "message"})
     header.push_back(c);
   // A best design of an earlier run must not stand beside this run's history.
   for (const char* stale : {"best.json", "best_scene.json"}) {
@@ -484,8 +498,9 @@ int Optimization::run() {
     for (size_t k = 0; k < nr; ++k)
       o.responses.push_back(std::strtod(r[2 + nv + k].c_str(), nullptr));
     o.status = r[2 + nv + nr + 2];
-    o.wall_seconds = std::strtod(r[2 + nv + nr + 3].c_str(), nullptr);
-    o.message = r[2 + nv + nr + 4];
+    o.warnings = static_cast<int>(std::strtol(r[2 + nv + nr + 3].c_str(), nullptr, 10));
+    o.wall_seconds = std::strtod(r[2 + nv + nr + 4].c_str(), nullptr);
+    o.message = r[2 + nv + nr + 5];
     cache_.try_emplace(x, o);
   }
 

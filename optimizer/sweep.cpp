@@ -17,16 +17,6 @@
 #include "optimizer/version.hpp"
 
 namespace beamrail {
-namespace {
-
-// One line of text per message (CSV rows must stay on one line).
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  return s;
-}
-
-}  // namespace
 
 int run_sweep(const Study& study, const RunSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
@@ -37,7 +27,7 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   CsvRow header{"index"};
   for (const DesignVariable& v : plan.variables) header.push_back(v.name);
   for (const ResponseSpec& r : study.responses) header.push_back(r.name);
-  for (const char* c : {"status", "wall_s", "message"}) header.push_back(c);
+  for (const char* c : {"status", "warnings", "wall_s", "message"}) header.push_back(c);
   const size_t status_column = 1 + plan.variables.size() + study.responses.size();
 
   const std::filesystem::path samples = settings.output / "samples.csv";
@@ -55,17 +45,19 @@ int run_sweep(const Study& study, const RunSettings& settings) {
       return 1;
   }
   std::set<long> done;
-  long failures = 0;
+  long failures = 0, warned = 0;
   for (const CsvRow& row : existing) {
     done.insert(std::strtol(row[0].c_str(), nullptr, 10));
     failures += row[status_column] != "ok";
+    warned += std::strtol(row[status_column + 1].c_str(), nullptr, 10) > 0;
   }
   std::vector<long> todo;
   for (long i = 0; i < static_cast<long>(designs.size()); ++i)
     if (!done.count(i)) todo.push_back(i);
 
   Progress progress(static_cast<long>(designs.size()), settings.quiet);
-  std::atomic<long> finished(static_cast<long>(done.size())), failed(failures), evaluated(0);
+  std::atomic<long> finished(static_cast<long>(done.size())), failed(failures), evaluated(0),
+      with_warnings(warned);
   std::atomic<bool> write_failed(false);
   const int threads = batch_threads(settings, static_cast<long>(todo.size()));
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
@@ -79,13 +71,15 @@ int run_sweep(const Study& study, const RunSettings& settings) {
     for (double x : designs[i]) row.push_back(format_number(x));
     for (double r : o.responses) row.push_back(format_number(r));
     row.push_back(o.status);
+    row.push_back(std::to_string(o.warnings));
     row.push_back(format_number(o.wall_seconds));
-    row.push_back(one_line(o.message));
+    row.push_back(o.message);
     if (!table.append(row)) {
       write_failed = true;
       continue;
     }
     ++evaluated;
+    if (o.warnings > 0) ++with_warnings;
     if (o.status != "ok") ++failed;
     progress.update(++finished, failed, "");
   }
@@ -113,6 +107,7 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   s["evaluated_now"] = evaluated.load();
   s["resumed_from_table"] = done.size();
   s["failed_or_invalid"] = failed.load();
+  s["designs_with_warnings"] = with_warnings.load();
   s["threads"] = threads;
   s["wall_seconds"] = wall;
   s["evaluations_per_second"] = wall > 0 ? static_cast<double>(evaluated.load()) / wall : 0.0;
@@ -136,7 +131,8 @@ int run_sweep(const Study& study, const RunSettings& settings) {
     return interrupted_exit_status(signal);
   }
   std::cout << study.name << ": " << designs.size() << " designs (" << failed.load()
-            << " failed or invalid) in " << wall << " s -> " << settings.output.string() << "\n";
+            << " failed or invalid, " << with_warnings.load() << " with warnings) in " << wall
+            << " s -> " << settings.output.string() << "\n";
   return 0;
 }
 

@@ -37,8 +37,10 @@ Commands:
 
 Options:
   -o, --output OUTDIR   where to write the results
-  -j, --threads N       threads for batch evaluation (default: all cores)
-  --resume              continue an interrupted run in OUTDIR
+  -j, --threads N       threads for batch evaluation, 1..1024 (default: all cores; never
+                        more than the designs evaluated at once)
+  --resume              continue an interrupted sweep or optimization in OUTDIR (refused
+                        when OUTDIR's tables were written by another version of the study)
   --quiet               no progress output
 
 Exit status: 0 success; 1 the run failed, or its results could not be written, or OUTDIR is

@@ -183,13 +183,20 @@ class Runner {
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);
-    if (!table_error.empty() && report.ok) {
+    if (!table_error.empty() && report.message.find(table_error) == std::string::npos) {
+      report.message = report.ok ? table_error : report.message + "; " + table_error;
       report.ok = false;
-      report.message = table_error;
     }
     if (!result.ok)
       for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
-    if (result.ok && spec.verify) report.verification = verify(options, trajectory);
+    if (report.ok && spec.verify) {
+      report.verification = verify(options, trajectory);
+      if (stop_requested() && !report.verification->ok) {
+        report.ok = false;
+        report.interrupted = true;
+        report.message = "interrupted in the verification rerun";
+      }
+    }
     return report;
   }
 

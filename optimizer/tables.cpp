@@ -135,10 +135,7 @@ bool CsvWriter::commit(std::string* error) {
     if (std::rename(file_.c_str(), path_.c_str()) == 0) {
       file_ = path_;
     } else {
-      const int e = errno;
-      if (error_.empty())
-        error_ =
-            "cannot rename " + file_.string() + " to " + path_.string() + ": " + std::strerror(e);
+      if (error_.empty()) error_ = write_error(path_, errno);
       ok_ = false;
     }
   }

@@ -468,21 +468,39 @@ TEST_F(ResultsFolder, AWriteErrorFailsTheRunWithTheFileAndTheReason) {
   }
 }
 
-// A full disk, by way of /dev/full: the first file a run writes is its "running" summary, and
-// every kind of study fails on it the same way.
+// A full disk, by way of /dev/full (writes to it fail with ENOSPC): wherever it strikes, the
+// first file a run writes (its "running" summary) or its first table, every kind of study fails
+// the same way, exit status 1, naming the file and the reason.
 TEST_F(ResultsFolder, AFullDiskFailsEveryKindOfStudyTheSameWay) {
-  for (const std::string study : {"tube_cantilever_sweep.json", "min_mass_rod.json",
-                                  "work_precision_reference.json", "bending_tip_load.json"}) {
-    SCOPED_TRACE(study);
-    fs::remove_all(dir_ / "out");
-    fs::create_directories(dir_ / "out");
-    fs::create_symlink("/dev/full", dir_ / "out" / "summary.json.tmp");
-    const ProcessResult r = run({"run", (kStudies / study).string(), "-o", "out", "--quiet"});
-    std::printf("%s: %s: %s", study.c_str(), r.how.c_str(), r.err.c_str());
-    EXPECT_TRUE(r.exited && r.status == 1) << r.how;
-    EXPECT_TRUE(
-        contains(r.err, std::string("cannot write out/summary.json: ") + std::strerror(ENOSPC)))
-        << r.err;
+  const struct {
+    const char* study;
+    const char* table;    // the first table it writes
+    const char* written;  // where it is written (a staged table: beside it)
+  } cases[] = {
+      {"tube_cantilever_sweep.json", "samples.csv", "samples.csv"},
+      {"min_mass_rod.json", "history.csv", "history.csv"},
+      {"work_precision_reference.json", "work_precision.csv", "work_precision.csv.partial"},
+      {"bending_tip_period.json", "timeseries.csv", "timeseries.csv.partial"}};
+  for (const auto& c : cases) {
+    for (const bool summary : {true, false}) {
+      SCOPED_TRACE(std::string(c.study) + (summary ? ", summary.json" : ", the first table"));
+      fs::remove_all(dir_ / "out");
+      fs::create_directories(dir_ / "out");
+      fs::create_symlink("/dev/full", dir_ / "out" / (summary ? "summary.json.tmp" : c.written));
+      Json s = load_json(kStudies / c.study);
+      if (std::string(c.study) == "work_precision_reference.json") {
+        s["scene"]["beams"][0]["segments"] = 2;
+        s["analyses"][0]["t_end"] = 0.002;
+      }
+      const fs::path file = write_study(c.study, s);
+      const ProcessResult r = run({"run", file.string(), "-o", "out", "--quiet"});
+      std::printf("%s: %s: %s", c.study, r.how.c_str(), r.err.c_str());
+      EXPECT_TRUE(r.exited && r.status == 1) << r.how;
+      EXPECT_TRUE(contains(r.err, "cannot write out/" +
+                                      std::string(summary ? "summary.json" : c.table) + ": " +
+                                      std::strerror(ENOSPC)))
+          << r.err;
+    }
   }
 }
 
@@ -495,8 +513,8 @@ TEST_F(ResultsFolder, ATableThatCannotBeWrittenIsExitStatus1ForEveryKindOfStudy)
     const char* table;
   } cases[] = {{"tube_cantilever_sweep.json", "samples.csv"},
                {"min_mass_rod.json", "history.csv"},
-               {"work_precision_reference.json", "work_precision.csv.partial"},
-               {"bending_tip_period.json", "timeseries.csv.partial"}};
+               {"work_precision_reference.json", "work_precision.csv"},
+               {"bending_tip_period.json", "timeseries.csv"}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.study);
     fs::remove_all(dir_ / "out");
@@ -510,9 +528,8 @@ TEST_F(ResultsFolder, ATableThatCannotBeWrittenIsExitStatus1ForEveryKindOfStudy)
     const ProcessResult r = run({"run", file.string(), "-o", "out", "--quiet"});
     std::printf("%s: %s: %s", c.study, r.how.c_str(), r.err.c_str());
     EXPECT_TRUE(r.exited && r.status == 1) << r.how;
-    std::string table = c.table;
-    table = table.substr(0, table.find(".partial"));
-    EXPECT_TRUE(contains(r.err, "cannot write out/" + table + ": " + std::strerror(EISDIR)))
+    EXPECT_TRUE(
+        contains(r.err, std::string("cannot write out/") + c.table + ": " + std::strerror(EISDIR)))
         << r.err;
   }
 }

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 #include "optimizer/tables.hpp"
@@ -55,6 +56,12 @@ bool OutputFolder::acquire(const fs::path& directory, std::string* error) {
   }
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int e = errno;
+    if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS) {
+      // A file system without locks (some network file systems): run, but say what is missing.
+      std::cerr << "warning: cannot lock " << lock.string() << " (" << std::strerror(e)
+                << "): a second run into " << directory.string() << " would not be refused\n";
+      return true;
+    }
     if (e == EWOULDBLOCK) {
       std::string holder = read_file(lock);
       while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();

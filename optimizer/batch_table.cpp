@@ -79,8 +79,9 @@ CsvRow parse_csv_line(const std::string& line) {
   return out;
 }
 
-bool BatchTable::open(const std::filesystem::path& path, const CsvRow& header, bool resume,
-                      std::vector<CsvRow>* existing, std::string* error) {
+BatchTable::Opened BatchTable::open(const std::filesystem::path& path, const CsvRow& header,
+                                    bool resume, std::vector<CsvRow>* existing,
+                                    std::string* error) {
   path_ = path;
   header_ = header;
   existing->clear();
@@ -93,42 +94,59 @@ bool BatchTable::open(const std::filesystem::path& path, const CsvRow& header, b
   if (!lines.empty()) {
     if (parse_csv_line(lines.front()) != header) {
       *error = "cannot resume: " + path.string() +
-               " was written by a different study (its columns differ); remove it or run "
-               "without --resume";
-      return false;
+               " has other columns than this study's table; remove it or run without --resume";
+      return Opened::kOtherColumns;
     }
     for (size_t i = 1; i < lines.size(); ++i) {
       CsvRow row = parse_csv_line(lines[i]);
       if (row.size() == header.size()) existing->push_back(std::move(row));
     }
     // Drop an unfinished last line, then append after the whole rows.
-    std::filesystem::resize_file(path, whole, ec);
-    fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd_ >= 0 && ::ftruncate(fd_, static_cast<off_t>(whole)) == 0 &&
+        ::lseek(fd_, 0, SEEK_END) >= 0) {
+      written_ = static_cast<off_t>(whole);
+      return Opened::kOk;
+    }
   } else {
     fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ >= 0) ok_ = write_all(fd_, join(header));
+    const std::string text = join(header);
+    if (fd_ >= 0 && write_all(fd_, text)) {
+      written_ = static_cast<off_t>(text.size());
+      return Opened::kOk;
+    }
   }
-  if (fd_ < 0 || !ok_) {
-    *error = "cannot write " + path.string() + ": " + std::strerror(errno);
-    return false;
-  }
-  return true;
+  *error = error_ = write_error(path, errno);
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  return Opened::kWriteError;
 }
 
 bool BatchTable::append(const CsvRow& row) {
   const std::string line = join(row);
   std::lock_guard<std::mutex> lock(mutex_);
-  if (fd_ < 0) return false;
-  ok_ = write_all(fd_, line) && ok_;
-  return ok_;
+  if (fd_ < 0 || !error_.empty()) return false;
+  if (write_all(fd_, line)) {
+    written_ += static_cast<off_t>(line.size());
+    return true;
+  }
+  error_ = write_error(path_, errno);
+  // The table stays a table of whole rows.
+  if (::ftruncate(fd_, written_) != 0) error_ += " (and the part of a row written stays)";
+  return false;
+}
+
+std::string BatchTable::error() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_;
 }
 
 bool BatchTable::finalize(const std::vector<int>& key_columns, std::string* error) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ >= 0 && ::close(fd_) != 0 && error_.empty()) error_ = write_error(path_, errno);
   fd_ = -1;
-  if (!ok_) {
-    *error = "writing " + path_.string() + " failed";
+  if (!error_.empty()) {
+    *error = error_;
     return false;
   }
   size_t whole = 0;

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "optimizer/design_study.hpp"
+#include "optimizer/nlopt_setup.hpp"
 #include "optimizer/study.hpp"
 
 namespace beamrail {
@@ -238,8 +239,14 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
       p.algorithm = *a;
   }
   if (const auto a = r.string("local_algorithm", false)) {
-    if (nlopt_algorithm_from_string(a->c_str()) < 0)
+    const nlopt_algorithm local = nlopt_algorithm_from_string(a->c_str());
+    if (local < 0)
       r.error("local_algorithm", "unknown NLopt algorithm \"" + *a + "\"");
+    else if (runs_local_optimizer(local))
+      r.error("local_algorithm", "\"" + *a +
+                                     "\" runs a local optimizer itself; the local optimizer of an "
+                                     "AUGLAG or MLSL algorithm must be a plain one (LN_COBYLA, "
+                                     "LD_MMA, LN_BOBYQA, ...)");
     else
       p.local_algorithm = *a;
   }
@@ -251,6 +258,9 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
   p.starts = static_cast<int>(std::min(r.integer("starts", false, 1).value_or(1), 100000L));
   p.seed = static_cast<unsigned long>(r.integer("seed", false, 0).value_or(1));
   p.gradient_step = r.positive("gradient_step", false).value_or(p.gradient_step);
+  if (const auto w = r.choice("warned_designs", false, {"infeasible", "accept"}))
+    p.warned_designs = *w == "accept" ? OptimizePlan::WarnedDesigns::kAccept
+                                      : OptimizePlan::WarnedDesigns::kInfeasible;
 }
 
 void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
@@ -332,6 +342,7 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
                "atol_scale",
                "reference",
                "target_error",
+               "warned_designs",
                "max_seconds_per_design"});
       return std::nullopt;
     }
@@ -369,6 +380,16 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
       read_sweep(r, study, d);
     else
       read_optimize(r, study, d);
+    // NLopt refuses some combinations (a missing algorithm, constraints an algorithm cannot take
+    // inside a wrapper) only when it runs: find out now instead of after the first evaluations.
+    if (d.type == DesignStudy::Type::kOptimize && diag.size() == errors_before) {
+      const std::string refusal = nlopt_refusal(d.optimize, d.variables);
+      if (!refusal.empty())
+        r.error(!value.contains("algorithm") && value.contains("local_algorithm")
+                    ? "local_algorithm"
+                    : "algorithm",
+                refusal);
+    }
   }
   if (diag.size() > errors_before) return std::nullopt;
   return d;

@@ -50,6 +50,11 @@ struct OptimizePlan {
   int starts = 1;
   unsigned long seed = 1;
   double gradient_step = 1e-6;  // central differences: h = step * (upper - lower)
+  // A design whose analyses gave warnings (the model's assumptions strained: large element
+  // rotations, a rail at its min_length, ...): counted as infeasible (as a failed design: the
+  // optimizer sees the penalty, and it is never the best) or accepted like any other.
+  enum class WarnedDesigns { kInfeasible, kAccept };
+  WarnedDesigns warned_designs = WarnedDesigns::kInfeasible;
 };
 
 // The measured speed-accuracy trade of the study's transient analysis: every method at every

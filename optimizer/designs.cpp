@@ -44,11 +44,16 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x) const {
       out.status = ev.status;
       out.message = ev.message;
       out.responses = ev.responses;
+      out.warnings = static_cast<int>(ev.warnings.size());
+      for (const std::string& w : ev.warnings)
+        out.message += (out.message.empty() ? "" : "; ") + std::string("warning: ") + w;
     }
   } catch (const std::exception& e) {
     out.status = "failed";
     out.message = e.what();
   }
+  for (char& c : out.message)  // a table row holds it on one line
+    if (c == '\n' || c == '\r') c = ' ';
   out.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -13,9 +13,12 @@
 namespace beamrail {
 
 struct DesignOutcome {
-  std::string status = "ok";  // ok | failed | timeout | invalid
+  std::string status = "ok";  // ok | failed | timeout | invalid | interrupted
+  // One line: why the design failed (if it did), then "warning: ..." for each warning of its
+  // analyses, separated by "; ".
   std::string message;
   std::vector<double> responses;  // one per study.responses (NaN when not computed)
+  int warnings = 0;               // how many warnings its analyses gave
   double wall_seconds = 0.0;
 };
 

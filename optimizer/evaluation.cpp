@@ -5,14 +5,28 @@
 #include <cmath>
 #include <limits>
 
+#include "core/analysis/stop_request.hpp"
 #include "optimizer/responses.hpp"
 #include "optimizer/result_tables.hpp"
+#include "optimizer/tables.hpp"
 #include "optimizer/trajectory.hpp"
 
 namespace beamrail {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+const char* analysis_name(AnalysisSpec::Type type) {
+  switch (type) {
+    case AnalysisSpec::Type::kStatic:
+      return "static";
+    case AnalysisSpec::Type::kModal:
+      return "modal";
+    case AnalysisSpec::Type::kTransient:
+      break;
+  }
+  return "transient";
+}
 
 class Runner {
  public:
@@ -41,7 +55,7 @@ class Runner {
     }
     const bool ok = report.ok;
     if (!ok) {
-      ev_.status = report.timed_out ? "timeout" : "failed";
+      ev_.status = report.interrupted ? "interrupted" : report.timed_out ? "timeout" : "failed";
       ev_.message = report.type + " analysis: " + report.message;
     }
     ev_.analyses.push_back(std::move(report));
@@ -138,8 +152,11 @@ class Runner {
       }
     TimeseriesWriter table;
     std::string table_error;
-    if (!options_.output_directory.empty())
-      table.open(options_.output_directory / "timeseries.csv", model_, &table_error);
+    const bool tables = !options_.output_directory.empty();
+    if (tables && !table.open(options_.output_directory / "timeseries.csv", model_, &table_error)) {
+      report.message = table_error;
+      return report;
+    }
 
     Trajectory trajectory = trajectory_of(model_);
     bool first = true;
@@ -154,15 +171,18 @@ class Runner {
                      std::abs(s.energy() - report.energy_initial) / scale);
       for (auto& [k, t] : peaks)
         ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
-      if (table.good()) table.write(s, d);
+      if (tables) table.write(s, d);  // throws when the table cannot be written: the run fails
       if (spec.verify) trajectory.record(s, d);
     };
     const TransientOptions options = budgeted(spec.transient);
     const TransientResult result = run_transient(model_, options, data, observer);
-    table.flush();
+    if (tables) table.commit(&table_error);
     report.ok = result.ok;
     report.timed_out = result.timed_out;
+    report.interrupted = result.interrupted;
     report.message = result.message;
+    if (result.interrupted)
+      report.message = "interrupted at t = " + format_number(result.t_reached) + " s";
     report.stats = result.stats;
     report.integrator = options.integrator.method;
     if (!options.integrator.table.empty()) report.integrator += " " + options.integrator.table;
@@ -170,13 +190,20 @@ class Runner {
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);
-    if (!table_error.empty()) {
+    if (!table_error.empty() && report.message.find(table_error) == std::string::npos) {
+      report.message = report.ok ? table_error : report.message + "; " + table_error;
       report.ok = false;
-      report.message = table_error;
     }
     if (!result.ok)
       for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
-    if (result.ok && spec.verify) report.verification = verify(options, trajectory);
+    if (report.ok && spec.verify) {
+      report.verification = verify(options, trajectory);
+      if (stop_requested() && !report.verification->ok) {
+        report.ok = false;
+        report.interrupted = true;
+        report.message = "interrupted in the verification rerun";
+      }
+    }
     return report;
   }
 
@@ -244,8 +271,15 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
       if (study.responses[k].quantity == ResponseSpec::Quantity::kMass)
         ev.responses[k] = structural_mass(model);
     Runner runner(study, model, options, ev, start);
-    for (const AnalysisSpec& spec : study.analyses)
+    for (const AnalysisSpec& spec : study.analyses) {
+      if (stop_requested()) {
+        ev.status = "interrupted";
+        ev.message =
+            "interrupted before the " + std::string(analysis_name(spec.type)) + " analysis";
+        break;
+      }
       if (!runner.run(spec)) break;
+    }
   } catch (const std::exception& e) {
     ev.status = "failed";
     ev.message = e.what();

@@ -26,7 +26,8 @@ struct Verification {
 struct AnalysisReport {
   std::string type;  // "transient", "static", "modal"
   bool ok = false;
-  bool timed_out = false;  // stopped by a max_seconds budget
+  bool timed_out = false;    // stopped by a max_seconds budget
+  bool interrupted = false;  // stopped by a stop request (SIGINT, SIGTERM)
   std::string message;
   double wall_seconds = 0.0;
   // transient
@@ -50,7 +51,7 @@ struct AnalysisReport {
 };
 
 struct Evaluation {
-  std::string status = "ok";  // ok | failed | timeout | invalid
+  std::string status = "ok";  // ok | failed | timeout | invalid | interrupted
   std::string message;
   std::vector<double> responses;  // one per study.responses, NaN when not computed
   std::vector<AnalysisReport> analyses;

@@ -1,7 +1,6 @@
 #include "optimizer/optimize.hpp"
 
 #include <nlopt.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <atomic>
@@ -12,8 +11,11 @@
 #include <map>
 #include <mutex>
 
+#include "core/analysis/stop_request.hpp"
 #include "optimizer/batch_table.hpp"
 #include "optimizer/designs.hpp"
+#include "optimizer/interruption.hpp"
+#include "optimizer/nlopt_setup.hpp"
 #include "optimizer/progress.hpp"
 #include "optimizer/sampling.hpp"
 #include "optimizer/summary.hpp"
@@ -27,38 +29,10 @@ namespace {
 constexpr double kPenalty = 1e30;
 // A constraint counts as met up to this fraction of its bound.
 constexpr double kFeasibility = 1e-9;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool needs_gradient(const std::string& algorithm) {
   return algorithm.size() > 2 && algorithm[1] == 'D';
-}
-
-bool handles_constraints(nlopt_algorithm a) {
-  switch (a) {
-    case NLOPT_LN_COBYLA:
-    case NLOPT_LD_MMA:
-    case NLOPT_LD_CCSAQ:
-    case NLOPT_LD_SLSQP:
-    case NLOPT_GN_ISRES:
-    case NLOPT_GN_ORIG_DIRECT:
-    case NLOPT_GN_ORIG_DIRECT_L:
-    case NLOPT_GN_AGS:
-    case NLOPT_AUGLAG:
-    case NLOPT_LN_AUGLAG:
-    case NLOPT_LD_AUGLAG:
-      return true;
-    default:
-      return false;
-  }
-}
-
-bool needs_local_optimizer(nlopt_algorithm a) {
-  return a == NLOPT_AUGLAG || a == NLOPT_AUGLAG_EQ || a == NLOPT_G_MLSL || a == NLOPT_G_MLSL_LDS;
-}
-
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  return s;
 }
 
 struct Record {
@@ -86,7 +60,10 @@ class Optimization {
     Optimization* self = nullptr;
     int index = 0;                  // 1-based
     std::map<Design, int> numbers;  // distinct designs of this start -> evaluation number
-    std::string result;             // NLopt's return code
+    nlopt_opt opt = nullptr;        // while it runs
+    nlopt_result result = NLOPT_SUCCESS;
+    std::string message;   // NLopt's own message on an error
+    bool stopped = false;  // stopped by us (a stop request or a write error)
     int nlopt_evaluations = 0;
   };
   struct ConstraintRef {
@@ -94,6 +71,9 @@ class Optimization {
     int j;
   };
 
+  // An evaluated design the optimization may use: ok, and without warnings unless they are
+  // accepted ("warned_designs").
+  bool usable(const DesignOutcome& o) const;
   double objective_of(const DesignOutcome& o) const;
   double constraint_of(const DesignOutcome& o, int j) const;
   bool feasible(const DesignOutcome& o) const;
@@ -110,7 +90,8 @@ class Optimization {
   void run_start(Start& start, const Design& x0);
   std::vector<Design> start_points() const;
   CsvRow row(const Record& r) const;
-  int report(const Record* best, const std::vector<Start>& starts, double wall) const;
+  int report(const Record* best, const std::vector<Start>& starts, double wall,
+             const std::string& history_error) const;
 
   const Study& study_;
   const OptimizePlan& plan_;
@@ -123,11 +104,20 @@ class Optimization {
   std::vector<Record> records_;
   std::mutex mutex_;
   std::atomic<long> simulated_{0}, failures_{0};
+  std::atomic<bool> write_failed_{false};
   int threads_ = 1;
 };
 
+// Whether the optimization must end now: a stop was requested or history.csv cannot be written.
+bool must_stop(const std::atomic<bool>& write_failed) { return stop_requested() || write_failed; }
+
+bool Optimization::usable(const DesignOutcome& o) const {
+  return o.status == "ok" &&
+         (o.warnings == 0 || plan_.warned_designs == OptimizePlan::WarnedDesigns::kAccept);
+}
+
 double Optimization::objective_of(const DesignOutcome& o) const {
-  if (o.status != "ok") return kPenalty;
+  if (!usable(o)) return kPenalty;
   double f = 0.0;
   switch (plan_.goal) {
     case OptimizePlan::Goal::kMinimize:
@@ -149,7 +139,7 @@ double Optimization::objective_of(const DesignOutcome& o) const {
 double Optimization::constraint_of(const DesignOutcome& o, int j) const {
   const Constraint& c = plan_.constraints[j];
   const double r = o.responses[c.response];
-  if (o.status != "ok" || !std::isfinite(r)) return kPenalty;
+  if (!usable(o) || !std::isfinite(r)) return kPenalty;
   const double scale = c.bound != 0.0 ? std::abs(c.bound) : 1.0;
   switch (c.kind) {
     case Constraint::Kind::kAtLeast:
@@ -162,7 +152,7 @@ double Optimization::constraint_of(const DesignOutcome& o, int j) const {
 }
 
 bool Optimization::feasible(const DesignOutcome& o) const {
-  if (o.status != "ok" || objective_of(o) >= kPenalty) return false;
+  if (!usable(o) || objective_of(o) >= kPenalty) return false;
   for (size_t j = 0; j < plan_.constraints.size(); ++j)
     if (!(constraint_of(o, static_cast<int>(j)) <= kFeasibility)) return false;
   return true;
@@ -175,8 +165,9 @@ CsvRow Optimization::row(const Record& r) const {
   out.push_back(format_number(r.objective));
   out.push_back(r.feasible ? "1" : "0");
   out.push_back(r.outcome.status);
+  out.push_back(std::to_string(r.outcome.warnings));
   out.push_back(format_number(r.outcome.wall_seconds));
-  out.push_back(one_line(r.outcome.message));
+  out.push_back(r.outcome.message);
   return out;
 }
 
@@ -196,19 +187,29 @@ std::vector<DesignOutcome> Optimization::outcomes(Start& start, const std::vecto
     }
   }
   const long n = static_cast<long>(xs.size());
-#pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1) num_threads(threads_)
+  const int threads = static_cast<int>(std::min<long>(threads_, n));
+#pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1) num_threads(threads)
   for (long i = 0; i < n; ++i)
     if (!known[i]) {
+      if (must_stop(write_failed_)) {
+        out[i].status = "interrupted";  // not evaluated
+        out[i].responses.assign(study_.responses.size(), kNaN);
+        continue;
+      }
       out[i] = evaluator_.evaluate(xs[i]);
+      if (out[i].status == "interrupted") continue;
       ++simulated_;
       if (out[i].status != "ok") ++failures_;
     }
   std::lock_guard<std::mutex> lock(mutex_);
   for (size_t i = 0; i < xs.size(); ++i) {
+    // An interrupted design is no result: neither cached nor in the history (a resumed run
+    // evaluates it).
+    if (out[i].status == "interrupted") continue;
     cache_.try_emplace(xs[i], out[i]);
     if (numbers[i] < 0) continue;
     Record r{start.index, numbers[i], xs[i], out[i], objective_of(out[i]), feasible(out[i])};
-    history_.append(row(r));
+    if (!history_.append(row(r))) write_failed_ = true;
     records_.push_back(std::move(r));
   }
   return out;
@@ -255,6 +256,10 @@ double Optimization::objective_callback(unsigned, const double* x, double* grad,
     Optimization& self = *start->self;
     const double v = self.value_and_gradient(
         *start, x, grad, [&](const DesignOutcome& o) { return self.objective_of(o); });
+    if (must_stop(self.write_failed_)) {
+      start->stopped = true;
+      nlopt_force_stop(start->opt);
+    }
     std::string best;
     self.progress_.update(self.simulated_, self.failures_, best);
     return v;
@@ -291,73 +296,108 @@ std::vector<Design> Optimization::start_points() const {
 }
 
 void Optimization::run_start(Start& start, const Design& x0) {
-  const unsigned n = static_cast<unsigned>(variables_.size());
-  const nlopt_algorithm algorithm = nlopt_algorithm_from_string(plan_.algorithm.c_str());
-  const bool gradient = needs_gradient(plan_.algorithm);
-  std::vector<nlopt_opt> owned;
-  const auto local_optimizer = [&](nlopt_opt outer, nlopt_algorithm a) {
-    nlopt_opt local = nlopt_create(a, n);
-    nlopt_set_xtol_rel(local, plan_.xtol_rel);
-    nlopt_set_ftol_rel(local, plan_.ftol_rel);
-    nlopt_set_local_optimizer(outer, local);
-    owned.push_back(local);
-  };
-  nlopt_opt opt = nullptr;
-  if (!plan_.constraints.empty() && !handles_constraints(algorithm)) {
-    // Algorithms without constraint support run inside an augmented Lagrangian.
-    opt = nlopt_create(gradient ? NLOPT_LD_AUGLAG : NLOPT_LN_AUGLAG, n);
-    local_optimizer(opt, algorithm);
-  } else {
-    opt = nlopt_create(algorithm, n);
-    if (needs_local_optimizer(algorithm) || plan_.algorithm.find("MLSL") != std::string::npos) {
-      const std::string name = !plan_.local_algorithm.empty() ? plan_.local_algorithm
-                               : gradient                     ? "LD_MMA"
-                                                              : "LN_COBYLA";
-      local_optimizer(opt, nlopt_algorithm_from_string(name.c_str()));
-    }
-  }
-  owned.push_back(opt);
-  std::vector<double> lower, upper;
-  for (const DesignVariable& v : variables_) lower.push_back(v.lower), upper.push_back(v.upper);
-  nlopt_set_lower_bounds(opt, lower.data());
-  nlopt_set_upper_bounds(opt, upper.data());
+  const NloptSetup setup(plan_, variables_);
+  nlopt_opt opt = setup.get();
   nlopt_set_min_objective(opt, objective_callback, &start);
   std::vector<ConstraintRef> refs;
   for (size_t j = 0; j < plan_.constraints.size(); ++j)
     refs.push_back(ConstraintRef{&start, static_cast<int>(j)});
   for (ConstraintRef& ref : refs)
     nlopt_add_inequality_constraint(opt, constraint_callback, &ref, 1e-8);
-  nlopt_set_xtol_rel(opt, plan_.xtol_rel);
-  nlopt_set_ftol_rel(opt, plan_.ftol_rel);
   nlopt_set_maxeval(opt, plan_.max_evaluations);
   if (plan_.max_seconds > 0) nlopt_set_maxtime(opt, plan_.max_seconds);
   nlopt_srand(plan_.seed + static_cast<unsigned long>(start.index));  // stochastic algorithms
 
   Design x = x0;
   double f = 0.0;
-  const nlopt_result result = nlopt_optimize(opt, x.data(), &f);
-  start.result = nlopt_result_to_string(result);
-  for (nlopt_opt o : owned) nlopt_destroy(o);
+  start.opt = opt;
+  start.result = nlopt_optimize(opt, x.data(), &f);
+  if (start.result < 0 && nlopt_get_errmsg(opt)) start.message = nlopt_get_errmsg(opt);
+  start.opt = nullptr;
 }
 
-int Optimization::report(const Record* best, const std::vector<Start>& starts, double wall) const {
+// What a start's NLopt result means for the study: "" (a normal stop), or a warning, or an error.
+struct StopMeaning {
+  std::string warning, error;
+};
+
+StopMeaning meaning_of(int index, nlopt_result result, bool stopped_by_us,
+                       const std::string& nlopt_message) {
+  StopMeaning m;
+  if (result > 0 || (result == NLOPT_FORCED_STOP && stopped_by_us)) return m;
+  const std::string start = "start " + std::to_string(index) + ": ";
+  const std::string name = nlopt_result_to_string(result);
+  if (result == NLOPT_ROUNDOFF_LIMITED) {
+    m.warning = start +
+                "NLopt stopped early because roundoff errors limited its progress "
+                "(ROUNDOFF_LIMITED): the designs it evaluated are in the history, but the best of "
+                "them may not be an optimum";
+    return m;
+  }
+  m.error = start + "NLopt failed (" + name + ")" +
+            (nlopt_message.empty() ? std::string() : ": " + nlopt_message);
+  return m;
+}
+
+int Optimization::report(const Record* best, const std::vector<Start>& starts, double wall,
+                         const std::string& history_error) const {
+  const int signal = stop_requested();
+  std::vector<std::string> warnings, errors;
+  bool stopped = false;
+  for (const Start& st : starts) {
+    const StopMeaning m = meaning_of(st.index, st.result, st.stopped, st.message);
+    if (!m.warning.empty()) warnings.push_back(m.warning);
+    if (!m.error.empty()) errors.push_back(m.error);
+    stopped = stopped || st.stopped;
+  }
+  const bool interrupted = signal != 0 && stopped;
+  std::string status, message;
+  if (!history_error.empty()) {
+    status = "failed", message = history_error;
+  } else if (!errors.empty()) {
+    status = "failed";
+    for (const std::string& e : errors) message += (message.empty() ? "" : "; ") + e;
+  } else if (interrupted) {
+    status = "interrupted";
+    message = "interrupted by " + signal_name(signal) + " after " +
+              std::to_string(records_.size()) + " designs";
+  } else if (best) {
+    status = "ok";
+  } else {
+    status = "infeasible";
+    message = "no evaluated design satisfies every constraint";
+    long warned = 0;
+    for (const Record& r : records_) warned += r.outcome.status == "ok" && r.outcome.warnings > 0;
+    if (warned > 0 && plan_.warned_designs == OptimizePlan::WarnedDesigns::kInfeasible)
+      message += " (" + std::to_string(warned) +
+                 " designs with warnings count as infeasible; their warnings are in the message "
+                 "column of history.csv; \"warned_designs\": \"accept\" accepts them)";
+  }
+
   nlohmann::json s;
   s["study"] = study_.name;
   s["file"] = study_.file;
   s["beamrail_version"] = kVersion;
   s["type"] = "optimize";
   s["algorithm"] = plan_.algorithm;
-  s["status"] = best ? "ok" : "infeasible";
-  s["message"] = best ? "" : "no evaluated design satisfies every constraint";
+  s["optimizer"] = NloptSetup(plan_, variables_).description();
+  s["status"] = status;
+  s["message"] = message;
+  s["warnings"] = warnings;
   nlohmann::json per_start = nlohmann::json::array();
   for (const Start& st : starts)
     per_start.push_back({{"start", st.index},
-                         {"nlopt_result", st.result},
+                         {"nlopt_result", nlopt_result_to_string(st.result)},
                          {"nlopt_evaluations", st.nlopt_evaluations},
                          {"designs", st.numbers.size()}});
   s["starts"] = per_start;
   s["designs_simulated"] = simulated_.load();
   s["designs_failed"] = failures_.load();
+  long warned = 0;
+  for (const Record& r : records_) warned += r.outcome.warnings > 0;
+  s["designs_with_warnings"] = warned;
+  s["warned_designs"] =
+      plan_.warned_designs == OptimizePlan::WarnedDesigns::kAccept ? "accept" : "infeasible";
   s["designs_in_history"] = records_.size();
   s["threads"] = threads_;
   s["wall_seconds"] = wall;
@@ -376,24 +416,44 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
       resp[study_.responses[k].name] = json_number(best->outcome.responses[k]);
     b["variables"] = vars;
     b["responses"] = resp;
-    s["best"] = b;
-    s["responses"] = resp;
-    Json scene = evaluator_.document(best->x);
-    scene["name"] = study_.name + "_best";
-    scene["description"] = "The best design found by " + plan_.algorithm + " for study \"" +
-                           study_.name + "\" (start " + std::to_string(best->start) +
-                           ", evaluation " + std::to_string(best->evaluation) + ").";
-    ok = write_file_atomically(settings_.output / "best.json", b.dump(2) + "\n", &error) &&
-         write_file_atomically(settings_.output / "best_scene.json", scene.dump(2) + "\n", &error);
+    if (status == "ok") {
+      s["best"] = b;
+      s["responses"] = resp;
+      Json scene = evaluator_.document(best->x);
+      scene["name"] = study_.name + "_best";
+      scene["description"] = "The best design found by " + plan_.algorithm + " for study \"" +
+                             study_.name + "\" (start " + std::to_string(best->start) +
+                             ", evaluation " + std::to_string(best->evaluation) + ").";
+      ok =
+          write_file_atomically(settings_.output / "best.json", b.dump(2) + "\n", &error) &&
+          write_file_atomically(settings_.output / "best_scene.json", scene.dump(2) + "\n", &error);
+    } else {
+      // An unfinished or failed optimization names no best design (no best.json): the best
+      // feasible design it evaluated is given for information.
+      s["best_evaluated"] = b;
+    }
   }
   ok = ok && write_file_atomically(settings_.output / "summary.json", s.dump(2) + "\n", &error);
+  for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
   if (!ok) {
     std::cerr << "beamrail: " << error << "\n";
     return 1;
   }
+  const std::string history = (settings_.output / "history.csv").string();
+  if (status == "failed") {
+    std::cerr << "beamrail: " << study_.name << " failed: " << message << "\n(" << records_.size()
+              << " designs evaluated are in " << history << "; no best.json is written)\n";
+    return 1;
+  }
+  if (status == "interrupted") {
+    std::cerr << "beamrail: " << study_.name << " interrupted by " << signal_name(signal) << ": "
+              << records_.size() << " designs are in " << history
+              << "; continue with: " << settings_.command << " --resume\n";
+    return interrupted_exit_status(signal);
+  }
   if (!best) {
-    std::cerr << "beamrail: " << study_.name << ": no feasible design found (" << records_.size()
-              << " designs evaluated); see " << settings_.output.string() << "/history.csv\n";
+    std::cerr << "beamrail: " << study_.name << ": " << message << " (" << records_.size()
+              << " designs evaluated); see " << history << "\n";
     return 1;
   }
   std::cout << study_.name << ": best objective " << format_number(best->objective) << " at";
@@ -409,14 +469,25 @@ int Optimization::run() {
   CsvRow header{"start", "evaluation"};
   for (const DesignVariable& v : variables_) header.push_back(v.name);
   for (const ResponseSpec& r : study_.responses) header.push_back(r.name);
-  for (const char* c : {"objective", "feasible", "status", "wall_s", "message"})
+  for (const char* c : {"objective", "feasible", "status", "warnings", "wall_s", "message"})
     header.push_back(c);
+  // A best design of an earlier run must not stand beside this run's history.
+  for (const char* stale : {"best.json", "best_scene.json"}) {
+    std::error_code ec;
+    std::filesystem::remove(settings_.output / stale, ec);
+  }
   std::vector<CsvRow> existing;
   std::string error;
-  if (!history_.open(settings_.output / "history.csv", header, settings_.resume, &existing,
-                     &error)) {
-    std::cerr << "beamrail: " << error << "\n";
-    return 2;
+  switch (history_.open(settings_.output / "history.csv", header, settings_.resume, &existing,
+                        &error)) {
+    case BatchTable::Opened::kOk:
+      break;
+    case BatchTable::Opened::kOtherColumns:
+      std::cerr << "beamrail: " << error << "\n";
+      return 2;
+    case BatchTable::Opened::kWriteError:
+      std::cerr << "beamrail: " << error << "\n";
+      return 1;
   }
   // Earlier evaluations become the cache that NLopt's replayed path hits.
   const size_t nv = variables_.size(), nr = study_.responses.size();
@@ -427,13 +498,18 @@ int Optimization::run() {
     for (size_t k = 0; k < nr; ++k)
       o.responses.push_back(std::strtod(r[2 + nv + k].c_str(), nullptr));
     o.status = r[2 + nv + nr + 2];
-    o.wall_seconds = std::strtod(r[2 + nv + nr + 3].c_str(), nullptr);
-    o.message = r[2 + nv + nr + 4];
+    o.warnings = static_cast<int>(std::strtol(r[2 + nv + nr + 3].c_str(), nullptr, 10));
+    o.wall_seconds = std::strtod(r[2 + nv + nr + 4].c_str(), nullptr);
+    o.message = r[2 + nv + nr + 5];
     cache_.try_emplace(x, o);
   }
 
-  threads_ = settings_.threads > 0 ? settings_.threads : omp_get_num_procs();
   const std::vector<Design> points = start_points();
+  // Designs evaluated at once: the starts, or the central-difference points of one gradient.
+  const long at_once =
+      std::max(static_cast<long>(points.size()),
+               needs_gradient(plan_.algorithm) ? 2 * static_cast<long>(variables_.size()) + 1 : 1);
+  threads_ = batch_threads(settings_, at_once);
   std::vector<Start> starts(points.size());
   for (size_t s = 0; s < points.size(); ++s)
     starts[s].self = this, starts[s].index = static_cast<int>(s) + 1;
@@ -442,10 +518,8 @@ int Optimization::run() {
     num_threads(std::min(threads_, n_starts))
   for (int s = 0; s < n_starts; ++s) run_start(starts[s], points[s]);
 
-  if (!history_.finalize({0, 1}, &error)) {
-    std::cerr << "beamrail: " << error << "\n";
-    return 1;
-  }
+  progress_.finish();
+  const bool written = history_.finalize({0, 1}, &error);
   // The best feasible design; ties go to the earliest (start, evaluation).
   const Record* best = nullptr;
   std::sort(records_.begin(), records_.end(), [](const Record& a, const Record& b) {
@@ -455,7 +529,8 @@ int Optimization::run() {
     if (r.feasible && (!best || r.objective < best->objective)) best = &r;
   return report(
       best, starts,
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count(),
+      written ? "" : error);
 }
 
 }  // namespace

@@ -12,8 +12,13 @@ Progress::Progress(long total, bool quiet)
       start_(std::chrono::steady_clock::now()),
       last_(start_) {}
 
-Progress::~Progress() {
+Progress::~Progress() { finish(); }
+
+void Progress::finish() {
+  std::lock_guard<std::mutex> lock(mutex_);
   if (printed_) std::fputc('\n', stderr);
+  printed_ = false;
+  active_ = false;
 }
 
 void Progress::update(long done, long failures, const std::string& best) {

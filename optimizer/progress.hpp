@@ -15,6 +15,8 @@ class Progress {
   // Records one finished design (thread-safe). `best` describes the best feasible design so far
   // (empty when none).
   void update(long done, long failures, const std::string& best);
+  // Ends the progress line (so that messages start on a line of their own).
+  void finish();
 
  private:
   long total_;

@@ -1,5 +1,7 @@
 #include "optimizer/result_tables.hpp"
 
+#include <stdexcept>
+
 #include "core/model/element_forces.hpp"
 #include "core/model/rotation.hpp"
 
@@ -16,7 +18,8 @@ bool TimeseriesWriter::open(const std::filesystem::path& path, const Model& mode
       header.push_back(model.bodies[i].name + c);
   }
   header.push_back("energy");
-  return table_.open(path, header, error);
+  flushed_ = std::chrono::steady_clock::now();
+  return table_.open(path, header, error, true);
 }
 
 void TimeseriesWriter::write(const TransientSample& sample, const Data& data) {
@@ -30,13 +33,19 @@ void TimeseriesWriter::write(const TransientSample& sample, const Data& data) {
   }
   row_.push_back(sample.energy());
   table_.row(row_);
+  const auto now = std::chrono::steady_clock::now();
+  if (now - flushed_ >= kTimeseriesFlushInterval) {
+    table_.flush();
+    flushed_ = now;
+  }
+  if (!table_.good()) throw std::runtime_error(table_.error());
 }
 
 bool write_static_tables(const std::filesystem::path& directory, const Model& model,
                          const Data& data, std::string* error) {
   CsvWriter displacements;
   if (!displacements.open(directory / "static_displacements.csv",
-                          {"body", "dx", "dy", "dz", "rx", "ry", "rz"}, error))
+                          {"body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
     return false;
   for (int i : model.free_bodies) {
     const Body& b = model.bodies[i];
@@ -47,7 +56,7 @@ bool write_static_tables(const std::filesystem::path& directory, const Model& mo
   }
   CsvWriter forces;
   if (!forces.open(directory / "element_forces.csv",
-                   {"element", "end", "fx", "fy", "fz", "mx", "my", "mz"}, error))
+                   {"element", "end", "fx", "fy", "fz", "mx", "my", "mz"}, error, true))
     return false;
   const auto rows = [&](const std::string& name, const EndForces& f) {
     for (int end = 1; end <= 2; ++end) {
@@ -61,15 +70,15 @@ bool write_static_tables(const std::filesystem::path& directory, const Model& mo
     rows(model.beams[i].name, beam_end_forces(model, data, static_cast<int>(i)));
   for (size_t i = 0; i < model.rails.size(); ++i)
     rows(model.rails[i].name, rail_end_forces(model, data, static_cast<int>(i)));
-  return displacements.flush() && forces.flush();
+  return displacements.commit(error) && forces.commit(error);
 }
 
 bool write_modal_tables(const std::filesystem::path& directory, const Model& model,
                         const ModalResult& result, std::string* error) {
   CsvWriter modes, shapes;
-  if (!modes.open(directory / "modes.csv", {"mode", "frequency_hz", "kind"}, error) ||
+  if (!modes.open(directory / "modes.csv", {"mode", "frequency_hz", "kind"}, error, true) ||
       !shapes.open(directory / "mode_shapes.csv",
-                   {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error))
+                   {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
     return false;
   int elastic = 0;
   for (const Mode& mode : result.modes) {
@@ -85,7 +94,7 @@ bool write_modal_tables(const std::filesystem::path& directory, const Model& mod
       shapes.row(row);
     }
   }
-  return modes.flush() && shapes.flush();
+  return modes.commit(error) && shapes.commit(error);
 }
 
 }  // namespace beamrail

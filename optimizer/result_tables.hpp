@@ -2,6 +2,7 @@
 // element forces, modes and mode shapes.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -12,12 +13,18 @@
 
 namespace beamrail {
 
-// timeseries.csv: t, then <body>.x,.y,.z,.q0..q3 for each free scene body, then energy.
+// timeseries.csv: t, then <body>.x,.y,.z,.q0..q3 for each free scene body, then energy. Written
+// as timeseries.csv.partial while the run lasts, its rows handed to the system at least every
+// second (a killed run leaves the rows up to then), and renamed to timeseries.csv by commit().
 class TimeseriesWriter {
  public:
   bool open(const std::filesystem::path& path, const Model& model, std::string* error);
+  // Adds a row; throws std::runtime_error naming the file and the reason when it cannot be
+  // written (the transient run then ends as failed).
   void write(const TransientSample& sample, const Data& data);
-  void flush() { table_.flush(); }
+  // Writes the rest and renames the table into place (also after a failed or interrupted run:
+  // its rows are kept). False with *error on any write error.
+  bool commit(std::string* error) { return table_.commit(error); }
   bool good() const { return table_.good(); }
 
  private:
@@ -25,15 +32,20 @@ class TimeseriesWriter {
   std::vector<Vec3> reference_;  // per listed body: its reference position
   std::vector<double> row_;
   CsvWriter table_;
+  std::chrono::steady_clock::time_point flushed_;
 };
 
+// Rows are handed to the system at least this often while a time series is written.
+inline constexpr std::chrono::seconds kTimeseriesFlushInterval{1};
+
 // static_displacements.csv (free bodies: dx, dy, dz and rotation vector rx, ry, rz) and
-// element_forces.csv (end forces of every beam and rail, element axes).
+// element_forces.csv (end forces of every beam and rail, element axes). Each table replaces the
+// previous one whole (written beside it and renamed).
 bool write_static_tables(const std::filesystem::path& directory, const Model& model,
                          const Data& data, std::string* error);
 
 // modes.csv (mode, frequency_hz, kind; rigid-body modes first with mode 0) and mode_shapes.csv
-// (elastic modes, M-normalized, per free body).
+// (elastic modes, M-normalized, per free body), each replacing the previous one whole.
 bool write_modal_tables(const std::filesystem::path& directory, const Model& model,
                         const ModalResult& result, std::string* error);
 

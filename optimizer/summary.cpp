@@ -39,9 +39,10 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
   nlohmann::json analyses = nlohmann::json::array();
   for (const AnalysisReport& a : ev.analyses) {
     nlohmann::json j{{"type", a.type},
-                     {"status", a.ok          ? "ok"
-                                : a.timed_out ? "timeout"
-                                              : "failed"},
+                     {"status", a.ok            ? "ok"
+                                : a.interrupted ? "interrupted"
+                                : a.timed_out   ? "timeout"
+                                                : "failed"},
                      {"message", a.message},
                      {"wall_seconds", a.wall_seconds}};
     if (a.type == "transient") {

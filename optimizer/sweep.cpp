@@ -1,15 +1,15 @@
 #include "optimizer/sweep.hpp"
 
-#include <omp.h>
-
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <iostream>
 #include <set>
 
+#include "core/analysis/stop_request.hpp"
 #include "optimizer/batch_table.hpp"
 #include "optimizer/designs.hpp"
+#include "optimizer/interruption.hpp"
 #include "optimizer/progress.hpp"
 #include "optimizer/sampling.hpp"
 #include "optimizer/summary.hpp"
@@ -17,16 +17,6 @@
 #include "optimizer/version.hpp"
 
 namespace beamrail {
-namespace {
-
-// One line of text per message (CSV rows must stay on one line).
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  return s;
-}
-
-}  // namespace
 
 int run_sweep(const Study& study, const RunSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
@@ -37,47 +27,67 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   CsvRow header{"index"};
   for (const DesignVariable& v : plan.variables) header.push_back(v.name);
   for (const ResponseSpec& r : study.responses) header.push_back(r.name);
-  for (const char* c : {"status", "wall_s", "message"}) header.push_back(c);
+  for (const char* c : {"status", "warnings", "wall_s", "message"}) header.push_back(c);
   const size_t status_column = 1 + plan.variables.size() + study.responses.size();
 
+  const std::filesystem::path samples = settings.output / "samples.csv";
   BatchTable table;
   std::vector<CsvRow> existing;
   std::string error;
-  if (!table.open(settings.output / "samples.csv", header, settings.resume, &existing, &error)) {
-    std::cerr << "beamrail: " << error << "\n";
-    return 2;
+  switch (table.open(samples, header, settings.resume, &existing, &error)) {
+    case BatchTable::Opened::kOk:
+      break;
+    case BatchTable::Opened::kOtherColumns:
+      std::cerr << "beamrail: " << error << "\n";
+      return 2;
+    case BatchTable::Opened::kWriteError:
+      std::cerr << "beamrail: " << error << "\n";
+      return 1;
   }
   std::set<long> done;
-  long failures = 0;
+  long failures = 0, warned = 0;
   for (const CsvRow& row : existing) {
     done.insert(std::strtol(row[0].c_str(), nullptr, 10));
     failures += row[status_column] != "ok";
+    warned += std::strtol(row[status_column + 1].c_str(), nullptr, 10) > 0;
   }
   std::vector<long> todo;
   for (long i = 0; i < static_cast<long>(designs.size()); ++i)
     if (!done.count(i)) todo.push_back(i);
 
   Progress progress(static_cast<long>(designs.size()), settings.quiet);
-  std::atomic<long> finished(static_cast<long>(done.size())), failed(failures);
-  const int threads = settings.threads > 0 ? settings.threads : omp_get_num_procs();
+  std::atomic<long> finished(static_cast<long>(done.size())), failed(failures), evaluated(0),
+      with_warnings(warned);
+  std::atomic<bool> write_failed(false);
+  const int threads = batch_threads(settings, static_cast<long>(todo.size()));
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
   for (long n = 0; n < static_cast<long>(todo.size()); ++n) {
+    // After a stop request or a write error no design starts.
+    if (stop_requested() || write_failed) continue;
     const long i = todo[n];
     const DesignOutcome o = evaluator.evaluate(designs[i]);
+    if (o.status == "interrupted") continue;  // not a result: a resumed run evaluates it
     CsvRow row{std::to_string(i)};
     for (double x : designs[i]) row.push_back(format_number(x));
     for (double r : o.responses) row.push_back(format_number(r));
     row.push_back(o.status);
+    row.push_back(std::to_string(o.warnings));
     row.push_back(format_number(o.wall_seconds));
-    row.push_back(one_line(o.message));
-    table.append(row);
+    row.push_back(o.message);
+    if (!table.append(row)) {
+      write_failed = true;
+      continue;
+    }
+    ++evaluated;
+    if (o.warnings > 0) ++with_warnings;
     if (o.status != "ok") ++failed;
     progress.update(++finished, failed, "");
   }
-  if (!table.finalize({0}, &error)) {
-    std::cerr << "beamrail: " << error << "\n";
-    return 1;
-  }
+  progress.finish();
+  const int signal = stop_requested();
+  const bool interrupted = signal != 0 && finished < static_cast<long>(designs.size());
+  // Sorted into index order; after a write error the table keeps the rows written before it.
+  const bool written = table.finalize({0}, &error);
 
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -86,21 +96,43 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   s["file"] = study.file;
   s["beamrail_version"] = kVersion;
   s["type"] = "sweep";
-  s["status"] = "ok";
+  s["status"] = !written ? "failed" : interrupted ? "interrupted" : "ok";
+  s["message"] = !written      ? error
+                 : interrupted ? "interrupted by " + signal_name(signal) + " after " +
+                                     std::to_string(finished.load()) + " of " +
+                                     std::to_string(designs.size()) + " designs"
+                               : "";
   s["designs"] = designs.size();
-  s["evaluated_now"] = todo.size();
+  s["designs_in_table"] = finished.load();
+  s["evaluated_now"] = evaluated.load();
   s["resumed_from_table"] = done.size();
   s["failed_or_invalid"] = failed.load();
+  s["designs_with_warnings"] = with_warnings.load();
   s["threads"] = threads;
   s["wall_seconds"] = wall;
-  s["evaluations_per_second"] = wall > 0 ? static_cast<double>(todo.size()) / wall : 0.0;
+  s["evaluations_per_second"] = wall > 0 ? static_cast<double>(evaluated.load()) / wall : 0.0;
   s["model"] = model_summary(study.model);
-  if (!write_file_atomically(settings.output / "summary.json", s.dump(2) + "\n", &error)) {
+  std::string summary_error;
+  const bool summarized =
+      write_file_atomically(settings.output / "summary.json", s.dump(2) + "\n", &summary_error);
+  if (!written) {
     std::cerr << "beamrail: " << error << "\n";
+    if (!summarized) std::cerr << "beamrail: " << summary_error << "\n";
     return 1;
   }
+  if (!summarized) {
+    std::cerr << "beamrail: " << summary_error << "\n";
+    return 1;
+  }
+  if (interrupted) {
+    std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
+              << finished.load() << " of " << designs.size() << " designs are in "
+              << samples.string() << "; continue with: " << settings.command << " --resume\n";
+    return interrupted_exit_status(signal);
+  }
   std::cout << study.name << ": " << designs.size() << " designs (" << failed.load()
-            << " failed or invalid) in " << wall << " s -> " << settings.output.string() << "\n";
+            << " failed or invalid, " << with_warnings.load() << " with warnings) in " << wall
+            << " s -> " << settings.output.string() << "\n";
   return 0;
 }
 

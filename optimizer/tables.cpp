@@ -45,28 +45,46 @@ std::string csv_field(const std::string& text) {
   return out + "\"";
 }
 
+std::string write_error(const std::filesystem::path& path, int errno_value) {
+  return "cannot write " + path.string() + ": " + std::strerror(errno_value);
+}
+
 CsvWriter::~CsvWriter() {
   flush();
   if (fd_ >= 0) ::close(fd_);
 }
 
+void CsvWriter::fail(const char* what) {
+  const int e = errno;
+  if (error_.empty()) error_ = std::string(what) + " " + path_.string() + ": " + std::strerror(e);
+  ok_ = false;
+}
+
 bool CsvWriter::open(const std::filesystem::path& path, const std::vector<std::string>& header,
-                     std::string* error) {
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+                     std::string* error, bool staged) {
+  path_ = path;
+  file_ = staged ? std::filesystem::path(path.string() + ".partial") : path;
+  fd_ = ::open(file_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
-    if (error) *error = "cannot write " + path.string() + ": " + std::strerror(errno);
+    fail("cannot write");
+    if (error) *error = error_;
     return false;
   }
   row(header);
-  return flush();
+  if (flush()) return true;
+  if (error) *error = error_;
+  return false;
 }
 
 bool CsvWriter::append(const std::filesystem::path& path, std::string* error) {
+  path_ = file_ = path;
   fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
   if (fd_ < 0) {
-    if (error) *error = "cannot append to " + path.string() + ": " + std::strerror(errno);
+    fail("cannot append to");
+    if (error) *error = error_;
     return false;
   }
+  written_ = ::lseek(fd_, 0, SEEK_END);
   return true;
 }
 
@@ -90,11 +108,38 @@ void CsvWriter::row(const std::vector<double>& values) {
 
 bool CsvWriter::flush(bool sync) {
   if (fd_ < 0) return false;
+  if (!ok_) {
+    buffer_.clear();
+    return false;
+  }
   if (!buffer_.empty()) {
-    ok_ = write_all(fd_, buffer_) && ok_;
+    if (write_all(fd_, buffer_)) {
+      written_ += static_cast<off_t>(buffer_.size());
+    } else {
+      fail("cannot write");
+      // Cut off what reached the file of the rows just written: the table ends with a whole row.
+      if (::ftruncate(fd_, written_) != 0) error_ += " (and the part of a row written stays)";
+    }
     buffer_.clear();
   }
-  if (sync) ok_ = (::fsync(fd_) == 0) && ok_;
+  if (ok_ && sync && ::fsync(fd_) != 0) fail("cannot write");
+  return ok_;
+}
+
+bool CsvWriter::commit(std::string* error) {
+  flush();
+  if (fd_ >= 0 && ::close(fd_) != 0 && ok_) fail("cannot write");
+  fd_ = -1;
+  // After a write error too: the rows that were written are whole, and they are this run's.
+  if (file_ != path_ && !file_.empty()) {
+    if (std::rename(file_.c_str(), path_.c_str()) == 0) {
+      file_ = path_;
+    } else {
+      if (error_.empty()) error_ = write_error(path_, errno);
+      ok_ = false;
+    }
+  }
+  if (!ok_ && error) *error = error_;
   return ok_;
 }
 
@@ -103,13 +148,15 @@ bool write_file_atomically(const std::filesystem::path& path, const std::string&
   const std::filesystem::path tmp = path.string() + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) {
-    if (error) *error = "cannot write " + tmp.string() + ": " + std::strerror(errno);
+    if (error) *error = write_error(tmp, errno);
     return false;
   }
-  const bool ok = write_all(fd, text) && ::fsync(fd) == 0;
-  ::close(fd);
-  if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    if (error) *error = "cannot write " + path.string() + ": " + std::strerror(errno);
+  int e = 0;
+  if (!write_all(fd, text) || ::fsync(fd) != 0) e = errno;
+  if (::close(fd) != 0 && e == 0) e = errno;
+  if (e == 0 && std::rename(tmp.c_str(), path.c_str()) != 0) e = errno;
+  if (e != 0) {
+    if (error) *error = write_error(path, e);
     std::remove(tmp.c_str());
     return false;
   }

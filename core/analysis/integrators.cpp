@@ -10,6 +10,8 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <memory>
 
 #include "core/analysis/klu_solver.hpp"
@@ -18,37 +20,136 @@
 namespace beamrail {
 namespace {
 
-// SUNDIALS' own words for its return flags, plus the model's side of the story.
-std::string explain(int flag, const std::string& module_message, const OdeContext& context) {
+// A state that is not finite after an accepted step (an error test passed by NaN): our own flag.
+constexpr int kNonFiniteState = -1000;
+
+// The symbolic name of a CVODE or ARKODE return flag ("CV_TOO_MUCH_WORK"); SUNDIALS allocates it.
+std::string flag_name(char* (*get)(long int), int flag) {
+  char* name = get(flag);
+  std::string out = name ? name : "";
+  std::free(name);
+  return out;
+}
+
+// Words for a return flag of CVODE or ARKODE (`name` without its "CV_" / "ARK_" prefix) and what
+// to do about it.
+std::string flag_meaning(const std::string& name, long max_steps) {
+  if (name == "TOO_MUCH_WORK")
+    return "too much work: the run used up its step budget (max_steps = " +
+           std::to_string(max_steps) +
+           " over the whole run); raise max_steps, loosen rtol/atol, or choose a method suited to "
+           "the problem (a stiff structure needs bdf, dirk or modal)";
+  if (name == "TOO_MUCH_ACC")
+    return "the tolerances cannot be met at the precision of the arithmetic: loosen rtol/atol";
+  if (name == "ERR_FAILURE")
+    return "the error test failed repeatedly, also at the smallest step: the motion may jump or "
+           "diverge; check the loads, or loosen rtol/atol";
+  if (name == "CONV_FAILURE")
+    return "the Newton iteration failed to converge repeatedly, also at the smallest step: the "
+           "motion may diverge; check the loads, or use \"jacobian\": \"exact\"";
+  if (name == "LINIT_FAIL" || name == "LSETUP_FAIL" || name == "LSOLVE_FAIL")
+    return "the linear solver failed (a singular Newton matrix): check the scene for bodies "
+           "without mass or inertia";
+  if (name == "RHSFUNC_FAIL" || name == "FIRST_RHSFUNC_ERR" || name == "REPTD_RHSFUNC_ERR" ||
+      name == "UNREC_RHSFUNC_ERR")
+    return "the forces became non-finite and smaller steps did not help: the motion diverged; "
+           "check the loads, the masses and the stiffnesses";
+  if (name == "ILL_INPUT")
+    return "the integrator refused its input: check t_end, output_step, max_step and "
+           "initial_step (too small for the arithmetic, or inconsistent)";
+  if (name == "TOO_CLOSE") return "t_end or output_step is too small to start the integration";
+  if (name == "MEM_FAIL") return "out of memory";
+  return "the integrator failed";
+}
+
+// The reason a run ended: the budget, a stop request, the model's side, or the integrator's flag
+// in words, with SUNDIALS' name of the flag and its own last message.
+std::string explain(int flag, const std::string& package, const std::string& name,
+                    const std::string& module_message, const OdeContext& context, long max_steps) {
+  if (context.interrupted) return "interrupted";
   if (context.timed_out) return "timeout: the run exceeded its max_seconds budget";
   if (!context.callback_error.empty())
     return "error while evaluating the model: " + context.callback_error;
-  std::string why;
-  switch (flag) {
-    case -1:  // *_TOO_MUCH_WORK
-      why = "too many steps (max_steps reached)";
-      break;
-    case -2:  // *_TOO_MUCH_ACC
-      why = "the tolerances cannot be met (too much accuracy requested)";
-      break;
-    case -3:  // *_ERR_FAILURE
-      why = "repeated error-test failures";
-      break;
-    case -4:  // *_CONV_FAILURE
-      why = "the Newton iteration does not converge";
-      break;
-    case -8:
-    case -9:
-    case -10:
-    case -11:  // right-hand-side failures (numbering differs by package; see the message)
-      why = "the forces became non-finite (the motion diverged)";
-      break;
-    default:
-      why = "solver flag " + std::to_string(flag);
-  }
+  if (!context.divergence.empty()) return context.divergence;
+  if (flag == kNonFiniteState)
+    return "the state became non-finite: the motion diverged; check the loads, the masses and "
+           "the stiffnesses";
+  const size_t underscore = name.find('_');
+  const std::string bare = underscore == std::string::npos ? name : name.substr(underscore + 1);
+  std::string why = flag_meaning(bare, max_steps) + " (" + package + " " +
+                    (name.empty() ? "flag" : name) + ", " + std::to_string(flag) + ")";
   if (!module_message.empty()) why += " [" + module_message + "]";
   return why;
 }
+
+// Whether every entry of y is finite.
+bool finite(N_Vector y) {
+  const double* a = N_VGetArrayPointer(y);
+  const long n = N_VGetLength(y);
+  for (long i = 0; i < n; ++i)
+    if (!std::isfinite(a[i])) return false;
+  return true;
+}
+
+SolverStats& operator+=(SolverStats& a, const SolverStats& b) {
+  a.steps += b.steps;
+  a.rhs_evaluations += b.rhs_evaluations;
+  a.jacobian_evaluations += b.jacobian_evaluations;
+  a.nonlinear_iterations += b.nonlinear_iterations;
+  a.nonlinear_failures += b.nonlinear_failures;
+  a.error_test_failures += b.error_test_failures;
+  return a;
+}
+
+// What the SUNDIALS integrators share: max_steps over the whole run (SUNDIALS counts them per call
+// and resets its counters when it restarts at a load's jump), statistics over the whole run, and a
+// check of the state after each call.
+class SundialsIntegrator : public Integrator {
+ public:
+  int advance(double tout, double tstop, N_Vector y, double* t) final {
+    const long left = max_steps_ - stats().steps;
+    if (left <= 0) return -1;  // *_TOO_MUCH_WORK
+    context_->nonfinite_evaluations = 0;
+    const int flag = evolve(tout, tstop, y, t, left);
+    if (flag >= 0 && !finite(y)) return kNonFiniteState;
+    return flag;
+  }
+  void restart(double t, N_Vector y) final {
+    before_ += segment_stats();
+    reinit(t, y);
+  }
+  SolverStats stats() const final {
+    SolverStats s = before_;
+    s += segment_stats();
+    return s;
+  }
+  std::string failure(int flag) const final {
+    return explain(flag, package_, flag < 0 && flag != kNonFiniteState ? name(flag) : "",
+                   messages_.last, *context_, max_steps_);
+  }
+
+ protected:
+  // Integrates to tout (not past tstop) taking at most max_steps steps.
+  virtual int evolve(double tout, double tstop, N_Vector y, double* t, long max_steps) = 0;
+  virtual void reinit(double t, N_Vector y) = 0;
+  // Counters since the last (re)initialization.
+  virtual SolverStats segment_stats() const = 0;
+  virtual std::string name(int flag) const = 0;
+
+  bool fail(std::string* error, const std::string& what) {
+    *error = what;
+    return false;
+  }
+
+  void* mem_ = nullptr;
+  OdeContext* context_ = nullptr;
+  SundialsMessages messages_;
+  long max_steps_ = 0;
+  std::string package_;
+
+ private:
+  SolverStats before_;  // up to the last restart
+};
 
 // Dense or sparse (KLU) matrix and solver for the implicit methods.
 struct LinearAlgebra {
@@ -90,11 +191,13 @@ struct LinearAlgebra {
   }
 };
 
-class Cvode : public Integrator {
+class Cvode : public SundialsIntegrator {
  public:
   bool init(const IntegratorOptions& o, OdeContext& c, SUNContext ctx, N_Vector y0,
             std::string* error) {
     context_ = &c;
+    package_ = "CVODE";
+    max_steps_ = std::max(1L, o.max_steps);
     mem_ = CVodeCreate(o.method == "adams" ? CV_ADAMS : CV_BDF, ctx);
     if (!mem_) return fail(error, "could not create CVODE");
     CVodeSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);
@@ -112,18 +215,21 @@ class Cvode : public Integrator {
     if (o.method == "bdf") CVodeSetProjFn(mem_, ode_project);
     CVodeSetMaxOrd(mem_, o.method == "adams" ? std::min(12, o.max_order) : o.max_order);
     if (o.stability_limit_detection && o.method == "bdf") CVodeSetStabLimDet(mem_, SUNTRUE);
-    CVodeSetMaxNumSteps(mem_, std::max(1L, o.max_steps));
     if (o.max_step > 0.0) CVodeSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) CVodeSetInitStep(mem_, o.initial_step);
     return true;
   }
   ~Cvode() override { CVodeFree(&mem_); }
-  int advance(double tout, double tstop, N_Vector y, double* t) override {
+
+ private:
+  int evolve(double tout, double tstop, N_Vector y, double* t, long max_steps) override {
+    CVodeSetMaxNumSteps(mem_, max_steps);
     CVodeSetStopTime(mem_, tstop);
     return CVode(mem_, tout, y, t, CV_NORMAL);
   }
-  void restart(double t, N_Vector y) override { CVodeReInit(mem_, t, y); }
-  SolverStats stats() const override {
+  void reinit(double t, N_Vector y) override { CVodeReInit(mem_, t, y); }
+  std::string name(int flag) const override { return flag_name(CVodeGetReturnFlagName, flag); }
+  SolverStats segment_stats() const override {
     SolverStats s;
     long fd = 0;
     CVodeGetNumSteps(mem_, &s.steps);
@@ -136,16 +242,7 @@ class Cvode : public Integrator {
     CVodeGetNumErrTestFails(mem_, &s.error_test_failures);
     return s;
   }
-  std::string failure(int flag) const override { return explain(flag, messages_.last, *context_); }
 
- private:
-  bool fail(std::string* error, const std::string& what) {
-    *error = what;
-    return false;
-  }
-  void* mem_ = nullptr;
-  OdeContext* context_ = nullptr;
-  SundialsMessages messages_;
   LinearAlgebra algebra_;
 };
 
@@ -154,11 +251,13 @@ std::string table_name(const std::string& name) {
   return name.rfind("ARKODE_", 0) == 0 ? name : "ARKODE_" + name;
 }
 
-class ArkodeImplicit : public Integrator {
+class ArkodeImplicit : public SundialsIntegrator {
  public:
   bool init(const IntegratorOptions& o, OdeContext& c, SUNContext ctx, N_Vector y0,
             std::string* error) {
     context_ = &c;
+    package_ = "ARKODE";
+    max_steps_ = std::max(1L, o.max_steps);
     mem_ = ARKStepCreate(nullptr, ode_rhs, 0.0, y0, ctx);
     if (!mem_) return fail(error, "could not create ARKODE");
     ARKStepSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);
@@ -178,18 +277,21 @@ class ArkodeImplicit : public Integrator {
     // the Newton solution and the variable-order predictor cut right-hand sides from 99k to 53k.
     ARKStepSetDeduceImplicitRhs(mem_, SUNTRUE);
     ARKStepSetPredictorMethod(mem_, 2);
-    ARKStepSetMaxNumSteps(mem_, std::max(1L, o.max_steps));
     if (o.max_step > 0.0) ARKStepSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) ARKStepSetInitStep(mem_, o.initial_step);
     return true;
   }
   ~ArkodeImplicit() override { ARKStepFree(&mem_); }
-  int advance(double tout, double tstop, N_Vector y, double* t) override {
+
+ private:
+  int evolve(double tout, double tstop, N_Vector y, double* t, long max_steps) override {
+    ARKStepSetMaxNumSteps(mem_, max_steps);
     ARKStepSetStopTime(mem_, tstop);
     return ARKStepEvolve(mem_, tout, y, t, ARK_NORMAL);
   }
-  void restart(double t, N_Vector y) override { ARKStepReInit(mem_, nullptr, ode_rhs, t, y); }
-  SolverStats stats() const override {
+  void reinit(double t, N_Vector y) override { ARKStepReInit(mem_, nullptr, ode_rhs, t, y); }
+  std::string name(int flag) const override { return flag_name(ARKStepGetReturnFlagName, flag); }
+  SolverStats segment_stats() const override {
     SolverStats s;
     long fe = 0, fi = 0, fd = 0;
     ARKStepGetNumSteps(mem_, &s.steps);
@@ -202,24 +304,17 @@ class ArkodeImplicit : public Integrator {
     ARKStepGetNumErrTestFails(mem_, &s.error_test_failures);
     return s;
   }
-  std::string failure(int flag) const override { return explain(flag, messages_.last, *context_); }
 
- private:
-  bool fail(std::string* error, const std::string& what) {
-    *error = what;
-    return false;
-  }
-  void* mem_ = nullptr;
-  OdeContext* context_ = nullptr;
-  SundialsMessages messages_;
   LinearAlgebra algebra_;
 };
 
-class ArkodeExplicit : public Integrator {
+class ArkodeExplicit : public SundialsIntegrator {
  public:
   bool init(const IntegratorOptions& o, OdeContext& c, SUNContext ctx, N_Vector y0,
             std::string* error) {
     context_ = &c;
+    package_ = "ARKODE";
+    max_steps_ = std::max(1L, o.max_steps);
     mem_ = ERKStepCreate(ode_rhs, 0.0, y0, ctx);
     if (!mem_) return fail(error, "could not create ARKODE");
     ERKStepSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);
@@ -229,34 +324,27 @@ class ArkodeExplicit : public Integrator {
     if (ERKStepSStolerances(mem_, o.rtol, o.atol) < 0 || ERKStepSetUserData(mem_, &c) < 0)
       return fail(error, "ARKODE set-up failed: " + messages_.last);
     ERKStepSetPostprocessStepFn(mem_, ode_normalize);
-    ERKStepSetMaxNumSteps(mem_, std::max(1L, o.max_steps));
     if (o.max_step > 0.0) ERKStepSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) ERKStepSetInitStep(mem_, o.initial_step);
     return true;
   }
   ~ArkodeExplicit() override { ERKStepFree(&mem_); }
-  int advance(double tout, double tstop, N_Vector y, double* t) override {
+
+ private:
+  int evolve(double tout, double tstop, N_Vector y, double* t, long max_steps) override {
+    ERKStepSetMaxNumSteps(mem_, max_steps);
     ERKStepSetStopTime(mem_, tstop);
     return ERKStepEvolve(mem_, tout, y, t, ARK_NORMAL);
   }
-  void restart(double t, N_Vector y) override { ERKStepReInit(mem_, ode_rhs, t, y); }
-  SolverStats stats() const override {
+  void reinit(double t, N_Vector y) override { ERKStepReInit(mem_, ode_rhs, t, y); }
+  std::string name(int flag) const override { return flag_name(ERKStepGetReturnFlagName, flag); }
+  SolverStats segment_stats() const override {
     SolverStats s;
     ERKStepGetNumSteps(mem_, &s.steps);
     ERKStepGetNumRhsEvals(mem_, &s.rhs_evaluations);
     ERKStepGetNumErrTestFails(mem_, &s.error_test_failures);
     return s;
   }
-  std::string failure(int flag) const override { return explain(flag, messages_.last, *context_); }
-
- private:
-  bool fail(std::string* error, const std::string& what) {
-    *error = what;
-    return false;
-  }
-  void* mem_ = nullptr;
-  OdeContext* context_ = nullptr;
-  SundialsMessages messages_;
 };
 
 template <class T>

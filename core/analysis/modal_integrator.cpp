@@ -431,10 +431,7 @@ class ModalExponential : public Integrator {
 
   // Advances by one accepted step (or to `target`). Returns a flag.
   int step_towards(double target) {
-    if (std::chrono::steady_clock::now() > context_->deadline) {
-      context_->timed_out = true;
-      return kTooManySteps;
-    }
+    if (context_->should_stop()) return kTooManySteps;
     if (stats_.steps >= options_.max_steps) return kTooManySteps;
     int flag = kOk;
     Block n0(n_, 2);

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
+#include <string>
 
 namespace beamrail {
 namespace {
@@ -24,19 +26,33 @@ int guarded(OdeContext* c, F&& f) {
   return -1;
 }
 
+// A non-finite state or right-hand side at time t: recoverable (the integrator retries with a
+// smaller step) until kNonFiniteLimit of them within one call of the integrator, then the end.
+int non_finite(OdeContext* c, double t, const char* what) {
+  if (++c->nonfinite_evaluations < kNonFiniteLimit) return 1;
+  char when[32];
+  std::snprintf(when, sizeof when, "%.9g", t);
+  c->divergence = std::string("the ") + what + " became non-finite at t = " + when +
+                  " s and smaller steps did not help (" + std::to_string(kNonFiniteLimit) +
+                  " attempts): the motion diverged; check the loads (their size and time "
+                  "functions), the masses and the stiffnesses";
+  return -1;
+}
+
 }  // namespace
 
 int ode_rhs(double t, N_Vector y, N_Vector ydot, void* user_data) {
   auto* c = static_cast<OdeContext*>(user_data);
-  if (std::chrono::steady_clock::now() > c->deadline) {
-    c->timed_out = true;
-    return -1;
-  }
+  if (c->should_stop() || !c->divergence.empty()) return -1;
   return guarded(c, [&] {
+    const double* s = N_VGetArrayPointer(y);
     double* f = N_VGetArrayPointer(ydot);
-    state_derivative(c->model, c->data, t, N_VGetArrayPointer(y), f);
-    for (long i = 0; i < c->model.n_states; ++i)
-      if (!std::isfinite(f[i])) return 1;  // recoverable: the integrator retries smaller
+    const long n = c->model.n_states;
+    for (long i = 0; i < n; ++i)
+      if (!std::isfinite(s[i])) return non_finite(c, t, "state");
+    state_derivative(c->model, c->data, t, s, f);
+    for (long i = 0; i < n; ++i)
+      if (!std::isfinite(f[i])) return non_finite(c, t, "forces");
     return 0;
   });
 }

@@ -1,6 +1,9 @@
 // The equations of motion as SUNDIALS sees them: right-hand side, exact Jacobian (dense or sparse
 // CSC with the structure of the model's topology), and the quaternion projection. Callbacks never
 // throw: an exception is recorded in the context and reported as an unrecoverable failure.
+// Non-finite forces are a recoverable failure (the integrator retries with a smaller step: a Newton
+// trial state may be far out) until kNonFiniteLimit of them pile up within one call of the
+// integrator; then the motion has diverged and the right-hand side fails unrecoverably.
 #pragma once
 
 #include <nvector/nvector_serial.h>
@@ -12,11 +15,15 @@
 #include <vector>
 
 #include "core/analysis/sparse_structure.hpp"
+#include "core/analysis/stop_request.hpp"
 #include "core/model/data.hpp"
 #include "core/model/dynamics.hpp"
 #include "core/model/model.hpp"
 
 namespace beamrail {
+
+// Non-finite right-hand sides tolerated within one call of the integrator (one output interval).
+inline constexpr long kNonFiniteLimit = 1000;
 
 struct OdeContext {
   OdeContext(const Model& m, Data& d) : model(m), data(d) {}
@@ -29,6 +36,16 @@ struct OdeContext {
   // Wall-clock budget: past this moment the right-hand side fails unrecoverably.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
   bool timed_out = false;
+  bool interrupted = false;        // a stop was requested (stop_request.hpp)
+  long nonfinite_evaluations = 0;  // in the current call of the integrator
+  std::string divergence;          // why the run was ended as diverged (non-finite forces)
+
+  // True, with timed_out or interrupted set, when the run must end now.
+  bool should_stop() {
+    if (stop_requested()) interrupted = true;
+    if (!interrupted && std::chrono::steady_clock::now() > deadline) timed_out = true;
+    return interrupted || timed_out;
+  }
 };
 
 // SUNDIALS callbacks; user_data is an OdeContext*.

@@ -90,7 +90,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
         if (flag < 0) {
           result.ok = false;
           result.timed_out = context.timed_out;
-          result.message = integrator->failure(flag);
+          result.interrupted = context.interrupted;
+          result.message = context.interrupted ? "interrupted" : integrator->failure(flag);
           break;
         }
         if (at_break && t >= stop) {

@@ -36,7 +36,7 @@ struct IntegratorOptions {
   bool stability_limit_detection = false;  // CVODE's BDF stability limit detection
   double max_step = 0.0;                   // [s]; 0: no limit
   double initial_step = 0.0;               // [s]; 0: the integrator's estimate
-  long max_steps = 10000000;               // total step budget over the run
+  long max_steps = 10000000;               // step budget of the whole run (all output steps)
   // modal: the configuration linearized about: "static" (the equilibrium under the loads at
   // t = 0), "initial" (the initial state), "" (static when that equilibrium is found within
   // kModalIntegratorMaxRotation of the initial state, else initial, with a warning).
@@ -73,6 +73,7 @@ struct SolverStats {
 struct TransientResult {
   bool ok = false;
   bool timed_out = false;      // stopped by max_seconds
+  bool interrupted = false;    // stopped by a stop request (stop_request.hpp)
   std::string linear_solver;   // dense | sparse | none
   long jacobian_nonzeros = 0;  // stored entries of the sparse Jacobian
   std::string message;         // why it stopped early, when !ok

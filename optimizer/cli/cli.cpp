@@ -6,8 +6,12 @@
 #include <iostream>
 #include <new>
 
+#include "core/analysis/stop_request.hpp"
 #include "optimizer/evaluation.hpp"
+#include "optimizer/interruption.hpp"
 #include "optimizer/optimize.hpp"
+#include "optimizer/output_folder.hpp"
+#include "optimizer/run_settings.hpp"
 #include "optimizer/study.hpp"
 #include "optimizer/summary.hpp"
 #include "optimizer/sweep.hpp"
@@ -33,12 +37,16 @@ Commands:
 
 Options:
   -o, --output OUTDIR   where to write the results
-  -j, --threads N       threads for batch evaluation (default: all cores)
-  --resume              continue an interrupted run in OUTDIR
+  -j, --threads N       threads for batch evaluation, 1..1024 (default: all cores; never
+                        more than the designs evaluated at once)
+  --resume              continue an interrupted sweep or optimization in OUTDIR (refused
+                        when OUTDIR's tables were written by another version of the study)
   --quiet               no progress output
 
-Exit status: 0 success; 1 a run failed (the reason is printed, partial tables are kept);
-2 bad input (unreadable or invalid study, bad command line).
+Exit status: 0 success; 1 the run failed, or its results could not be written, or OUTDIR is
+in use by another run (the reason is printed, partial tables are kept); 2 bad input (unreadable
+or invalid study, bad command line, --resume of tables another study wrote); 130 and 143
+interrupted by SIGINT and SIGTERM (what was computed is kept).
 )";
 
 struct RunArguments {
@@ -76,8 +84,13 @@ std::optional<int> parse_run_arguments(const std::vector<std::string>& args, boo
       const auto v = value("N");
       try {
         size_t used = 0;
-        out.threads = v ? std::stoi(*v, &used) : -1;
-        if (!v || used != v->size() || out.threads < 1) throw std::invalid_argument("");
+        const long n = v ? std::stol(*v, &used) : -1;
+        if (!v || used != v->size() || n < 1) throw std::invalid_argument("");
+        if (n > kMaxThreads)
+          return usage_error(a + " " + *v + ": at most " + std::to_string(kMaxThreads) +
+                             " threads (a batch never uses more threads than designs it can "
+                             "evaluate at once)");
+        out.threads = static_cast<int>(n);
       } catch (const std::exception&) {
         return usage_error(a + " needs a positive number of threads");
       }
@@ -112,6 +125,55 @@ int check(const RunArguments& args) {
   return 0;
 }
 
+// The command that runs the study again into the same folder.
+std::string command_line(const RunArguments& args, const std::filesystem::path& out) {
+  std::string c = "beamrail run " + args.study + " -o " + out.string();
+  if (args.threads > 0) c += " -j " + std::to_string(args.threads);
+  return c;
+}
+
+// The table a resumed batch continues ("" when the study cannot resume).
+std::string resumable_table(const Study& study) {
+  if (!study.design) return "";
+  switch (study.design->type) {
+    case DesignStudy::Type::kSweep:
+      return "samples.csv";
+    case DesignStudy::Type::kOptimize:
+      return "history.csv";
+    case DesignStudy::Type::kWorkPrecision:
+      break;
+  }
+  return "";
+}
+
+int run_single(const Study& study, const std::filesystem::path& out) {
+  const Evaluation ev = evaluate(study, study.model, {out});
+  const nlohmann::json summary = evaluation_summary(study, study.model, ev);
+  std::string error;
+  if (!write_file_atomically(out / "summary.json", summary.dump(2) + "\n", &error)) {
+    std::cerr << "beamrail: " << error << "\n";
+    return 1;
+  }
+  for (const std::string& w : ev.warnings) std::cerr << "warning: " << w << "\n";
+  if (ev.status == "interrupted") {
+    const int signal = stop_requested();
+    std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
+              << ev.message << "; the tables in " << out.string()
+              << " hold what was computed up to then (summary.json says so); run it again to "
+                 "compute it all\n";
+    return interrupted_exit_status(signal);
+  }
+  if (ev.status != "ok") {
+    std::cerr << "beamrail: " << study.name << " " << ev.status << ": " << ev.message
+              << "\n(partial results kept in " << out.string() << ")\n";
+    return 1;
+  }
+  std::cout << study.name << ": ok in " << ev.wall_seconds << " s -> " << out.string() << "\n";
+  for (size_t k = 0; k < study.responses.size(); ++k)
+    std::cout << "  " << study.responses[k].name << " = " << format_number(ev.responses[k]) << "\n";
+  return 0;
+}
+
 int run(const RunArguments& args) {
   Diagnostics diag;
   const auto study = load_study_file(args.study, diag);
@@ -122,15 +184,28 @@ int run(const RunArguments& args) {
   const std::filesystem::path out = args.output.empty()
                                         ? std::filesystem::path("results") / study->name
                                         : std::filesystem::path(args.output);
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec || !std::filesystem::is_directory(out)) {
-    std::cerr << "beamrail: cannot create the output directory " << out << ": " << ec.message()
-              << "\n";
+  // Held until the run ends: a second run into the same folder is refused.
+  OutputFolder folder;
+  std::string error;
+  if (!folder.acquire(out, &error)) {
+    std::cerr << "beamrail: " << error << "\n";
+    return 1;
+  }
+  const std::string table = resumable_table(*study);
+  if (args.resume && !table.empty()) {
+    const std::string refusal = resume_refusal(*study, out, table);
+    if (!refusal.empty()) {
+      std::cerr << "beamrail: " << refusal << "\n";
+      return 2;
+    }
+  }
+  if (!folder.start(*study, &error)) {
+    std::cerr << "beamrail: " << error << "\n";
     return 1;
   }
 
-  const RunSettings settings{out, args.threads, args.resume, args.quiet};
+  const StopOnSignals signals;
+  const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {
     switch (study->design->type) {
       case DesignStudy::Type::kSweep:
@@ -141,25 +216,7 @@ int run(const RunArguments& args) {
         return run_work_precision(*study, settings);
     }
   }
-
-  const Evaluation ev = evaluate(*study, study->model, {out});
-  const nlohmann::json summary = evaluation_summary(*study, study->model, ev);
-  std::string error;
-  if (!write_file_atomically(out / "summary.json", summary.dump(2) + "\n", &error)) {
-    std::cerr << "beamrail: " << error << "\n";
-    return 1;
-  }
-  for (const std::string& w : ev.warnings) std::cerr << "warning: " << w << "\n";
-  if (ev.status != "ok") {
-    std::cerr << "beamrail: " << study->name << " " << ev.status << ": " << ev.message
-              << "\n(partial results kept in " << out.string() << ")\n";
-    return 1;
-  }
-  std::cout << study->name << ": ok in " << ev.wall_seconds << " s -> " << out.string() << "\n";
-  for (size_t k = 0; k < study->responses.size(); ++k)
-    std::cout << "  " << study->responses[k].name << " = " << format_number(ev.responses[k])
-              << "\n";
-  return 0;
+  return run_single(*study, out);
 }
 
 int dispatch(const std::vector<std::string>& args) {

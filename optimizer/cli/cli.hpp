@@ -7,7 +7,8 @@
 namespace beamrail {
 
 // Runs the command line with arguments args (without the program name). Returns the exit status:
-// 0 success, 1 a run failed, 2 bad input or usage. Never throws.
+// 0 success, 1 a run failed or its results could not be written, 2 bad input or usage, 128 + the
+// signal's number when SIGINT or SIGTERM interrupted the run. Never throws.
 int run_command_line(const std::vector<std::string>& args);
 
 }  // namespace beamrail

@@ -1,10 +1,12 @@
 // Runs a program (the beamrail binary) from a test: fork/exec in a given directory, stdout and
 // stderr captured to files, with a time limit so that a hang fails like a crash. A started process
-// can also be left running and killed, to test what an interrupted run leaves behind.
+// can also be left running and killed, to test what an interrupted run leaves behind, and started
+// with resource limits (file size, address space).
 #pragma once
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,12 +35,19 @@ inline std::string read_text(const std::filesystem::path& path) {
   return s.str();
 }
 
+// Resource limits of a started process (-1: inherited).
+struct Limits {
+  long file_size = -1;      // RLIMIT_FSIZE [bytes]; SIGXFSZ is then ignored, so that a write
+                            // past it fails with EFBIG instead of killing the process
+  long address_space = -1;  // RLIMIT_AS [bytes]
+};
+
 // A process started in `dir` with stdout and stderr going to dir/.stdout and dir/.stderr
 // (the names can be changed with `tag`).
 class Process {
  public:
   Process(const std::string& exe, const std::vector<std::string>& args,
-          const std::filesystem::path& dir, const std::string& tag = "")
+          const std::filesystem::path& dir, const std::string& tag = "", Limits limits = {})
       : out_path_((dir / (".stdout" + tag)).string()),
         err_path_((dir / (".stderr" + tag)).string()) {
     const std::string where = dir.string();
@@ -54,6 +63,17 @@ class Process {
       if (out < 0 || err < 0 || chdir(where.c_str()) != 0) _exit(127);
       dup2(out, 1);
       dup2(err, 2);
+      if (limits.file_size >= 0) {
+        const rlimit r{static_cast<rlim_t>(limits.file_size),
+                       static_cast<rlim_t>(limits.file_size)};
+        signal(SIGXFSZ, SIG_IGN);
+        if (setrlimit(RLIMIT_FSIZE, &r) != 0) _exit(126);
+      }
+      if (limits.address_space >= 0) {
+        const rlimit r{static_cast<rlim_t>(limits.address_space),
+                       static_cast<rlim_t>(limits.address_space)};
+        if (setrlimit(RLIMIT_AS, &r) != 0) _exit(126);
+      }
       execv(exe.c_str(), argv.data());
       _exit(127);
     }
@@ -125,8 +145,9 @@ class Process {
 // Runs a program to its end (at most `limit`).
 inline ProcessResult run_process(const std::string& exe, const std::vector<std::string>& args,
                                  const std::filesystem::path& dir,
-                                 std::chrono::milliseconds limit = std::chrono::seconds(60)) {
-  Process p(exe, args, dir);
+                                 std::chrono::milliseconds limit = std::chrono::seconds(60),
+                                 Limits limits = {}) {
+  Process p(exe, args, dir, "", limits);
   return p.wait(limit);
 }
 

@@ -1,0 +1,165 @@
+// How a transient run ends when it cannot go on: the step budget max_steps holds for the whole
+// run (across output steps and the restarts at load jumps), a load that overflows ends the run as
+// failed in bounded time, the integrators' flags come out in words, and a stop request ends the
+// run as interrupted with the samples delivered so far.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <string>
+#include <vector>
+
+#include "core/analysis/stop_request.hpp"
+#include "core/analysis/transient.hpp"
+#include "tests/support/transient_run.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::scene_from_json;
+using testing::simulate;
+
+// A steel cantilever (1 m, 10 mm square) with a 1 kg tip body; `loads` is spliced in.
+Model cantilever(const std::string& loads) {
+  return scene_from_json(R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.1e10, "density": 7850}},
+    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "tip", "mass": 1.0, "inertia": [0.001, 0.001, 0.001],
+                "position": [1, 0, 0]}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel",
+               "section": "sq10"}],
+    "loads": )" + loads + "}");
+}
+
+TransientOptions run_options(const std::string& method, double t_end, double output_step) {
+  TransientOptions o;
+  o.t_end = t_end;
+  o.output_step = output_step;
+  o.integrator.method = method;
+  o.max_seconds = 60.0;  // a guard: every run here ends in well under a second
+  return o;
+}
+
+const std::vector<std::string> kMethods = {"bdf", "adams", "dirk", "erk", "modal"};
+const std::vector<std::string> kSundialsMethods = {"bdf", "adams", "dirk", "erk"};
+
+// 100 output steps need more than 50 steps with every method (the modal integrator takes one
+// step per output step here, the others more); a per-output-step budget of 50 would let them all
+// finish.
+TEST(TransientLimits, MaxStepsIsTheBudgetOfTheWholeRun) {
+  const Model model = cantilever(R"([{"type": "force", "body": "tip", "value": [0, -1, 0]}])");
+  for (const std::string& method : kMethods) {
+    SCOPED_TRACE(method);
+    TransientOptions o = run_options(method, 1.0, 0.01);
+    o.integrator.max_steps = 50;
+    const auto run = simulate(model, o);
+    std::printf("%s, max_steps 50: %s at t = %.4g after %ld steps: %s\n", method.c_str(),
+                run.result.ok ? "ok" : "failed", run.result.t_reached, run.result.stats.steps,
+                run.result.message.c_str());
+    EXPECT_FALSE(run.result.ok);
+    EXPECT_FALSE(run.result.timed_out);
+    EXPECT_LE(run.result.stats.steps, 50);
+    EXPECT_LT(run.result.t_reached, 1.0);
+    EXPECT_NE(run.result.message.find("max_steps"), std::string::npos) << run.result.message;
+  }
+}
+
+// A second load steps up at 0.25 s: the integrator restarts there. The run to 0.3 s integrates
+// [0, 0.25] as the run to 0.25 s does, then a little more: its counts are larger (counts of the
+// last piece alone would be smaller), and a budget of two steps more than the first piece takes is
+// too small for it (a budget per piece would be plenty).
+TEST(TransientLimits, StepsAndBudgetCountAcrossTheRestartsAtLoadJumps) {
+  const Model model = cantilever(
+      R"([{"type": "force", "body": "tip", "value": [0, -1, 0]},
+          {"type": "force", "body": "tip", "value": [0, -1, 0], "time": {"type": "step",
+           "at": 0.25}}])");
+  for (const std::string& method : kSundialsMethods) {
+    SCOPED_TRACE(method);
+    const auto first = simulate(model, run_options(method, 0.25, 0.05));
+    const auto whole = simulate(model, run_options(method, 0.3, 0.05));
+    ASSERT_TRUE(first.result.ok) << first.result.message;
+    ASSERT_TRUE(whole.result.ok) << whole.result.message;
+    const SolverStats &a = first.result.stats, &b = whole.result.stats;
+    std::printf("%s: to 0.25 s %ld steps, %ld rhs; to 0.3 s %ld steps, %ld rhs\n", method.c_str(),
+                a.steps, a.rhs_evaluations, b.steps, b.rhs_evaluations);
+    EXPECT_GT(b.steps, a.steps);
+    EXPECT_GT(b.rhs_evaluations, a.rhs_evaluations);
+
+    TransientOptions tight = run_options(method, 0.3, 0.05);
+    tight.integrator.max_steps = a.steps + 2;
+    const auto cut = simulate(model, tight);
+    EXPECT_FALSE(cut.result.ok);
+    EXPECT_LE(cut.result.stats.steps, a.steps + 2);
+    EXPECT_NE(cut.result.message.find("max_steps"), std::string::npos) << cut.result.message;
+  }
+}
+
+// A force ramping to 1e300 N from 0.1 s: the forces overflow right after 0.1 s. Every method must
+// end the run as failed (not run on with ever smaller steps until a budget stops it).
+TEST(TransientLimits, AnOverflowingLoadEndsTheRunAsFailed) {
+  const Model model = cantilever(
+      R"([{"type": "force", "body": "tip", "value": [0, -1e300, 0], "time": {"type": "ramp",
+           "from": 0.1, "to": 0.2}}])");
+  for (const std::string& method : kSundialsMethods) {
+    SCOPED_TRACE(method);
+    TransientOptions o = run_options(method, 1.0, 0.01);
+    o.max_seconds = 20.0;
+    const auto run = simulate(model, o);
+    std::printf("%s: %s at t = %.6g after %ld steps, %.3f s: %s\n", method.c_str(),
+                run.result.ok ? "ok" : "failed", run.result.t_reached, run.result.stats.steps,
+                run.result.stats.wall_seconds, run.result.message.c_str());
+    EXPECT_FALSE(run.result.ok);
+    EXPECT_FALSE(run.result.timed_out) << "ran on until the guard of 20 s stopped it";
+    EXPECT_NE(run.result.message.find("non-finite"), std::string::npos) << run.result.message;
+    EXPECT_NEAR(run.result.t_reached, 0.1, 1e-9);
+    // The samples up to the overflow were delivered, none after it.
+    ASSERT_FALSE(run.samples.empty());
+    EXPECT_NEAR(run.samples.back().sample.t, 0.1, 1e-12);
+    for (const auto& s : run.samples) EXPECT_TRUE(std::isfinite(s.sample.energy())) << s.sample.t;
+  }
+}
+
+// CVODE and ARKODE return numbers; the run's message must say in words what went wrong and what to
+// do, naming the flag. An end time below what the arithmetic can step to is refused as ILL_INPUT.
+TEST(TransientLimits, IntegratorFlagsComeOutInWords) {
+  const Model model = cantilever(R"([{"type": "force", "body": "tip", "value": [0, -1, 0]}])");
+  for (const std::string& method : kSundialsMethods) {
+    SCOPED_TRACE(method);
+    const auto run = simulate(model, run_options(method, 1e-300, 1e-300));
+    std::printf("%s, t_end 1e-300: %s\n", method.c_str(), run.result.message.c_str());
+    ASSERT_FALSE(run.result.ok);
+    const std::string& m = run.result.message;
+    EXPECT_EQ(m.find("solver flag"), std::string::npos) << m;
+    EXPECT_NE(m.find(method == "bdf" || method == "adams" ? "CV_ILL_INPUT" : "ARK_ILL_INPUT"),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find("check t_end, output_step"), std::string::npos) << m;
+  }
+}
+
+// A stop request (what SIGINT and SIGTERM make) ends a run as interrupted at its next
+// right-hand side, keeping the samples delivered so far.
+TEST(TransientLimits, AStopRequestEndsTheRunAsInterrupted) {
+  const Model model = cantilever(R"([{"type": "force", "body": "tip", "value": [0, -1, 0]}])");
+  for (const std::string& method : kMethods) {
+    SCOPED_TRACE(method);
+    Data data(model);
+    int samples = 0;
+    const TransientResult r = run_transient(model, run_options(method, 1.0, 0.01), data,
+                                            [&samples](const TransientSample&, const Data&) {
+                                              if (++samples == 5) request_stop(SIGINT);
+                                            });
+    clear_stop_request();
+    std::printf("%s: %s at t = %g after %d samples\n", method.c_str(), r.message.c_str(),
+                r.t_reached, samples);
+    EXPECT_FALSE(r.ok);
+    EXPECT_TRUE(r.interrupted);
+    EXPECT_FALSE(r.timed_out);
+    EXPECT_EQ(r.message, "interrupted");
+    EXPECT_EQ(samples, 5);
+    EXPECT_LT(r.t_reached, 0.05 + 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace beamrail

@@ -1,0 +1,211 @@
+// How an optimization ends, through the real command line: NLopt combinations it cannot run are
+// bad input when the study is read (not a start point reported as the optimum), wrappers get the
+// local optimizers they need (MLSL inside an augmented Lagrangian, LN_AUGLAG itself), an NLopt
+// failure fails the study, and ROUNDOFF_LIMITED is reported as a warning.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tests/support/run_process.hpp"
+
+#ifndef BEAMRAIL_EXECUTABLE
+#error "BEAMRAIL_EXECUTABLE must name the beamrail binary"
+#endif
+#ifndef BEAMRAIL_STUDIES_DIR
+#error "BEAMRAIL_STUDIES_DIR must name the studies/ directory"
+#endif
+
+namespace beamrail {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using testing::ProcessResult;
+using testing::read_text;
+
+const fs::path kStudies = BEAMRAIL_STUDIES_DIR;
+
+Json load_json(const fs::path& path) { return Json::parse(read_text(path)); }
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// The lightest rod keeping f1 >= 20 Hz (studies/min_mass_rod.json): the optimum is d* = 31.80 mm
+// on the constraint, objective (mass) 8.234 kg.
+Json rod(const std::string& algorithm, int max_evaluations) {
+  Json s = load_json(kStudies / "min_mass_rod.json");
+  s["study"]["algorithm"] = algorithm;
+  s["study"]["max_evaluations"] = max_evaluations;
+  return s;
+}
+
+class OptimizerStops : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "beamrail_stops_XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  ProcessResult run(const std::string& name, const Json& study,
+                    const std::string& command = "run") {
+    std::ofstream(dir_ / name) << study.dump(2);
+    std::vector<std::string> args{command, name};
+    if (command == "run") args.insert(args.end(), {"-o", "out", "--quiet"});
+    return testing::run_process(BEAMRAIL_EXECUTABLE, args, dir_, std::chrono::seconds(60));
+  }
+  fs::path dir_;
+};
+
+// MLSL takes no constraints: it runs inside LN_AUGLAG, and needs a local optimizer of its own
+// there. Without one, NLopt stopped every start after its first evaluation (INVALID_ARGS, or a
+// crash for GN_MLSL_LDS) and the study reported the start point as the optimum.
+TEST_F(OptimizerStops, MlslWithConstraintsRunsInsideAnAugmentedLagrangian) {
+  for (const std::string algorithm : {"G_MLSL_LDS", "GN_MLSL_LDS"}) {
+    SCOPED_TRACE(algorithm);
+    Json s = rod(algorithm, 60);
+    s["study"]["starts"] = 2;
+    const ProcessResult r = run("mlsl.json", s);
+    ASSERT_TRUE(r.exited && r.status == 0) << r.how << "\n" << r.err;
+    const Json summary = load_json(dir_ / "out" / "summary.json");
+    const Json best = load_json(dir_ / "out" / "best.json");
+    std::printf("%s: %s, %s, best d = %.6g, objective %.6g\n", algorithm.c_str(),
+                summary["optimizer"].get<std::string>().c_str(), summary["starts"].dump().c_str(),
+                best["variables"]["d"].get<double>(), best["objective"].get<double>());
+    EXPECT_EQ(summary["status"], "ok");
+    EXPECT_EQ(summary["optimizer"], "LN_AUGLAG(" + algorithm + "(LN_COBYLA))");
+    for (const Json& start : summary["starts"]) {
+      EXPECT_GT(start["designs"].get<int>(), 10) << start.dump();
+      const std::string result = start["nlopt_result"];
+      EXPECT_TRUE(result == "MAXEVAL_REACHED" || result == "XTOL_REACHED" ||
+                  result == "FTOL_REACHED" || result == "SUCCESS")
+          << result;
+    }
+    // Better than the initial point (d = 50 mm, 17.41 kg) and feasible.
+    EXPECT_LT(best["objective"].get<double>(), 12.0);
+    EXPECT_GE(best["responses"]["f1"].get<double>(), 20.0 * (1 - 1e-9));
+    fs::remove_all(dir_ / "out");
+  }
+}
+
+// An AUGLAG variant named as the algorithm gets the default local optimizer (NLopt's own default
+// crashed the process), with and without constraints.
+TEST_F(OptimizerStops, AugmentedLagrangiansNamedAsTheAlgorithmRun) {
+  // (LD_AUGLAG with the constraint works too, but needs a few seconds.)
+  const std::pair<std::string, bool> cases[] = {{"LN_AUGLAG", true},
+                                                {"LN_AUGLAG", false},
+                                                {"LN_AUGLAG_EQ", true},
+                                                {"LN_AUGLAG_EQ", false},
+                                                {"LD_AUGLAG", false}};
+  for (const auto& [algorithm, constrained] : cases) {
+    SCOPED_TRACE(algorithm + (constrained ? " with a constraint" : " without constraints"));
+    Json s = rod(algorithm, 100);
+    if (!constrained) {
+      s["study"].erase("constraints");
+      s["study"]["objective"] = Json::parse(R"({"target": {"f1": 25.0}})");
+    }
+    const ProcessResult r = run("auglag.json", s);
+    std::printf("%s%s: %s %s", algorithm.c_str(), constrained ? " constrained" : "", r.how.c_str(),
+                r.out.c_str());
+    ASSERT_TRUE(r.exited && r.status == 0) << r.how << "\n" << r.err;
+    const Json summary = load_json(dir_ / "out" / "summary.json");
+    EXPECT_EQ(summary["status"], "ok");
+    EXPECT_GT(summary["designs_in_history"].get<int>(), 10);
+    // Better than the initial point (17.41 kg; f1 = 48 Hz, 23 Hz off the target).
+    EXPECT_LT(load_json(dir_ / "out" / "best.json")["objective"].get<double>(),
+              constrained ? 17.0 : 1e-3);
+    fs::remove_all(dir_ / "out");
+  }
+}
+
+// What NLopt refuses to run is refused when the study is read, by `check` and `run` alike: exit
+// status 2, one line "file:/json/pointer: message", nothing written.
+TEST_F(OptimizerStops, CombinationsNloptCannotRunAreBadInput) {
+  Json local_wrapper = rod("AUGLAG", 40);
+  local_wrapper["study"]["local_algorithm"] = "LN_AUGLAG";
+  const struct {
+    const char* what;
+    Json study;
+    const char* where;
+    const char* message;
+  } cases[] = {
+      {"an algorithm this NLopt lacks", rod("GD_STOGO", 40),
+       "rod.json:/study/algorithm: NLopt cannot run LD_AUGLAG(GD_STOGO) with 1 constraint",
+       "INVALID_ARGS"},
+      {"NEWUOA in one dimension", rod("LN_NEWUOA_BOUND", 40),
+       "rod.json:/study/algorithm: NLopt cannot run LN_AUGLAG(LN_NEWUOA_BOUND) with 1 constraint",
+       "INVALID_ARGS"},
+      {"a wrapper as the local optimizer", local_wrapper,
+       "rod.json:/study/local_algorithm: ", "\"LN_AUGLAG\" runs a local optimizer itself"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    for (const std::string command : {"check", "run"}) {
+      const ProcessResult r = run("rod.json", c.study, command);
+      std::printf("%s, %s: %s: %s", c.what, command.c_str(), r.how.c_str(), r.err.c_str());
+      EXPECT_TRUE(r.exited && r.status == 2) << r.how;
+      EXPECT_EQ(r.err.rfind(c.where, 0), 0u) << r.err;
+      EXPECT_TRUE(contains(r.err, c.message)) << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_FALSE(fs::exists(dir_ / "out"));
+    }
+  }
+}
+
+// LD_LBFGS inside LD_AUGLAG, given central differences over 40 % of the variable's range (a
+// gradient it cannot follow), ends with NLopt's FAILURE: the study fails (exit status 1,
+// summary.json "failed" with NLopt's result), and no best.json claims an optimum.
+TEST_F(OptimizerStops, AnNloptFailureFailsTheStudy) {
+  Json s = rod("LD_LBFGS", 200);
+  s["study"]["gradient_step"] = 0.4;
+  const ProcessResult r = run("lbfgs.json", s);
+  std::printf("%s: %s", r.how.c_str(), r.err.c_str());
+  ASSERT_TRUE(r.exited) << r.how;
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  ASSERT_EQ(summary["starts"][0]["nlopt_result"], "FAILURE")
+      << "this case no longer makes NLopt fail; choose another";
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(summary["status"], "failed");
+  EXPECT_TRUE(contains(summary["message"].get<std::string>(), "start 1: NLopt failed (FAILURE)"))
+      << summary["message"];
+  EXPECT_TRUE(contains(r.err, "failed: start 1: NLopt failed (FAILURE)")) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "best.json"));
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "best_scene.json"));
+  EXPECT_FALSE(summary.contains("best"));
+}
+
+// LD_SLSQP on a rod that may not exceed 40 mm, with f1 >= 25 Hz, ends ROUNDOFF_LIMITED next to
+// the optimum: the best design stands (it is feasible), with a warning in summary.json and on
+// stderr.
+TEST_F(OptimizerStops, RoundoffLimitedIsReportedAsAWarning) {
+  Json s = rod("LD_SLSQP", 200);
+  s["study"]["constraints"][0][">="] = 25.0;
+  s["study"]["variables"][0]["upper"] = 0.04;
+  s["study"]["variables"][0]["initial"] = 0.03;
+  const ProcessResult r = run("slsqp.json", s);
+  std::printf("%s: %s%s", r.how.c_str(), r.out.c_str(), r.err.c_str());
+  ASSERT_TRUE(r.exited) << r.how;
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  ASSERT_EQ(summary["starts"][0]["nlopt_result"], "ROUNDOFF_LIMITED")
+      << "this case no longer ends ROUNDOFF_LIMITED; choose another";
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(summary["status"], "ok");
+  ASSERT_EQ(summary["warnings"].size(), 1u);
+  EXPECT_TRUE(contains(summary["warnings"][0].get<std::string>(), "ROUNDOFF_LIMITED"));
+  EXPECT_TRUE(contains(r.err, "warning: start 1: NLopt stopped early")) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "best.json"));
+}
+
+}  // namespace
+}  // namespace beamrail

@@ -1,5 +1,6 @@
 #include "optimizer/nlopt_setup.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 namespace beamrail {
@@ -81,11 +82,19 @@ bool runs_local_optimizer(nlopt_algorithm a) {
   }
 }
 
+double scaled_variable(const DesignVariable& v, double x) {
+  return (x - v.lower) / (v.upper - v.lower);
+}
+
+double physical_variable(const DesignVariable& v, double s) {
+  return std::clamp(v.lower + s * (v.upper - v.lower), v.lower, v.upper);
+}
+
 NloptSetup::NloptSetup(const OptimizePlan& plan, const std::vector<DesignVariable>& variables) {
   const unsigned n = static_cast<unsigned>(variables.size());
   const bool gradient = needs_gradient(plan.algorithm);
-  std::vector<double> lower, upper;
-  for (const DesignVariable& v : variables) lower.push_back(v.lower), upper.push_back(v.upper);
+  // NLopt sees every variable scaled to [0, 1] by its bounds (scaled_variable).
+  const std::vector<double> lower(n, 0.0), upper(n, 1.0);
   // An optimizer with the bounds and tolerances; `description` names it.
   const auto make = [&](nlopt_algorithm a) {
     nlopt_opt o = nlopt_create(a, n);
@@ -126,10 +135,8 @@ NloptSetup::~NloptSetup() {
 
 std::string nlopt_refusal(const OptimizePlan& plan, const std::vector<DesignVariable>& variables) {
   TestProblem problem;
-  for (const DesignVariable& v : variables) {
-    problem.middle.push_back(0.5 * (v.lower + v.upper));
-    problem.range.push_back(v.upper - v.lower);
-  }
+  problem.middle.assign(variables.size(), 0.5);  // in the scaled variables
+  problem.range.assign(variables.size(), 1.0);
   const NloptSetup setup(plan, variables);
   nlopt_opt opt = setup.get();
   nlopt_set_min_objective(opt, test_objective, &problem);

@@ -35,6 +35,12 @@ class NloptSetup {
   std::string description_;
 };
 
+// NLopt works on the variables scaled to [0, 1] by their bounds, s = (x - lower) / (upper - lower),
+// so that a diameter in metres and a position in metres or a modulus in pascals weigh alike in its
+// steps, tolerances (xtol_rel applies to s) and quasi-Newton models.
+double scaled_variable(const DesignVariable& v, double x);
+double physical_variable(const DesignVariable& v, double s);  // clamped to the bounds
+
 // Whether `algorithm` runs a local optimizer of its own (AUGLAG and MLSL variants).
 bool runs_local_optimizer(nlopt_algorithm algorithm);
 

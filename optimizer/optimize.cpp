@@ -65,6 +65,7 @@ class Optimization {
     std::string message;   // NLopt's own message on an error
     bool stopped = false;  // stopped by us (a stop request or a write error)
     int nlopt_evaluations = 0;
+    double objective_scale = 1.0;  // NLopt sees objective / this: |objective| at the start point
   };
   struct ConstraintRef {
     Start* start;
@@ -84,6 +85,10 @@ class Optimization {
   template <class F>
   double value_and_gradient(Start& start, const double* x, double* grad, F&& f);
 
+  // NLopt's view: scaled variables s in [0, 1]^n (scaled_variable) and the objective divided by
+  // the start's objective_scale; f(outcome) -> the value, gradient by the chain rule.
+  template <class F>
+  double scaled_value(Start& start, const double* s, double* grad, double scale, F&& f);
   static double objective_callback(unsigned n, const double* x, double* grad, void* data);
   static double constraint_callback(unsigned n, const double* x, double* grad, void* data);
 
@@ -249,13 +254,28 @@ double Optimization::value_and_gradient(Start& start, const double* x, double* g
   return value;
 }
 
+template <class F>
+double Optimization::scaled_value(Start& start, const double* s, double* grad, double scale,
+                                  F&& f) {
+  const size_t n = variables_.size();
+  Design x(n);
+  for (size_t i = 0; i < n; ++i) x[i] = physical_variable(variables_[i], s[i]);
+  std::vector<double> gx(n, 0.0);
+  const double v = value_and_gradient(start, x.data(), grad ? gx.data() : nullptr, f);
+  if (grad)
+    for (size_t i = 0; i < n; ++i)
+      grad[i] = gx[i] * (variables_[i].upper - variables_[i].lower) / scale;
+  return v >= kPenalty ? v : v / scale;
+}
+
 double Optimization::objective_callback(unsigned, const double* x, double* grad, void* data) {
   auto* start = static_cast<Start*>(data);
   try {
     ++start->nlopt_evaluations;
     Optimization& self = *start->self;
-    const double v = self.value_and_gradient(
-        *start, x, grad, [&](const DesignOutcome& o) { return self.objective_of(o); });
+    const double v =
+        self.scaled_value(*start, x, grad, start->objective_scale,
+                          [&](const DesignOutcome& o) { return self.objective_of(o); });
     if (must_stop(self.write_failed_)) {
       start->stopped = true;
       nlopt_force_stop(start->opt);
@@ -273,8 +293,8 @@ double Optimization::constraint_callback(unsigned, const double* x, double* grad
   try {
     Optimization& self = *ref->start->self;
     const int j = ref->j;
-    return self.value_and_gradient(
-        *ref->start, x, grad, [&](const DesignOutcome& o) { return self.constraint_of(o, j); });
+    return self.scaled_value(*ref->start, x, grad, 1.0,
+                             [&](const DesignOutcome& o) { return self.constraint_of(o, j); });
   } catch (...) {
     return kPenalty;
   }
@@ -308,7 +328,12 @@ void Optimization::run_start(Start& start, const Design& x0) {
   if (plan_.max_seconds > 0) nlopt_set_maxtime(opt, plan_.max_seconds);
   nlopt_srand(plan_.seed + static_cast<unsigned long>(start.index));  // stochastic algorithms
 
-  Design x = x0;
+  // The objective's scale: its magnitude at the start point (constraints are already relative to
+  // their bounds).
+  const double f0 = objective_of(outcomes(start, {x0}, false)[0]);
+  start.objective_scale = f0 < kPenalty && std::abs(f0) > 0.0 ? std::abs(f0) : 1.0;
+  Design x(x0.size());
+  for (size_t i = 0; i < x0.size(); ++i) x[i] = scaled_variable(variables_[i], x0[i]);
   double f = 0.0;
   start.opt = opt;
   start.result = nlopt_optimize(opt, x.data(), &f);

@@ -163,12 +163,12 @@ TEST_F(OptimizerStops, CombinationsNloptCannotRunAreBadInput) {
   }
 }
 
-// LD_LBFGS inside LD_AUGLAG, given central differences over 40 % of the variable's range (a
+// LD_LBFGS inside LD_AUGLAG, given central differences over 45 % of the variable's range (a
 // gradient it cannot follow), ends with NLopt's FAILURE: the study fails (exit status 1,
 // summary.json "failed" with NLopt's result), and no best.json claims an optimum.
 TEST_F(OptimizerStops, AnNloptFailureFailsTheStudy) {
   Json s = rod("LD_LBFGS", 200);
-  s["study"]["gradient_step"] = 0.4;
+  s["study"]["gradient_step"] = 0.45;
   const ProcessResult r = run("lbfgs.json", s);
   std::printf("%s: %s", r.how.c_str(), r.err.c_str());
   ASSERT_TRUE(r.exited) << r.how;
@@ -185,11 +185,12 @@ TEST_F(OptimizerStops, AnNloptFailureFailsTheStudy) {
   EXPECT_FALSE(summary.contains("best"));
 }
 
-// LD_SLSQP on a rod that may not exceed 40 mm, with f1 >= 25 Hz, ends ROUNDOFF_LIMITED next to
-// the optimum: the best design stands (it is feasible), with a warning in summary.json and on
-// stderr.
+// LD_SLSQP on a rod that may not exceed 40 mm, with f1 >= 25 Hz and central differences over
+// 40 % of the range, ends ROUNDOFF_LIMITED next to the optimum: the best design stands (it is
+// feasible), with a warning in summary.json and on stderr.
 TEST_F(OptimizerStops, RoundoffLimitedIsReportedAsAWarning) {
   Json s = rod("LD_SLSQP", 200);
+  s["study"]["gradient_step"] = 0.4;
   s["study"]["constraints"][0][">="] = 25.0;
   s["study"]["variables"][0]["upper"] = 0.04;
   s["study"]["variables"][0]["initial"] = 0.03;

@@ -1,7 +1,8 @@
 // The range of the element laws (DESIGN.md §1). The beam and rail laws take the relative rotation
 // angles phi of an element as if they were small, and measure them as three atan2 angles of the
 // relative rotation: the law is smooth only while every |phi_i| < pi/2 (the angles' derivative T
-// is singular at a bending angle of pi/2) and jumps where an angle passes pi. So:
+// is singular at a bending angle of pi/2) and jumps where an angle passes pi (kElementAngleLimit,
+// beam_out_of_range and rail_out_of_range in core/model). So:
 //  - an element whose largest |phi_i| passes kSmallAngleLimit is reported as a warning (the
 //    small-angle law is inaccurate there);
 //  - one that passes kElementAngleLimit is outside the law's range: the analysis fails and names
@@ -22,7 +23,6 @@
 namespace beamrail {
 
 inline constexpr double kSmallAngleLimit = 0.5;     // [rad]
-inline constexpr double kElementAngleLimit = 1.5;   // [rad], below pi/2
 inline constexpr double kRailTravelWarning = 10.0;  // times the initial distance
 
 // The first element outside the range of its law in the configuration of data.pose, described

@@ -76,6 +76,11 @@ std::string explain(int flag, const std::string& package, const std::string& nam
            "the stiffnesses";
   const size_t underscore = name.find('_');
   const std::string bare = underscore == std::string::npos ? name : name.substr(underscore + 1);
+  // Repeated right-hand-side or Newton failures over states outside the element laws' range.
+  if (!context.out_of_range.empty() && (bare.find("RHSFUNC") != std::string::npos ||
+                                        bare == "CONV_FAILURE" || bare == "ERR_FAILURE"))
+    return context.out_of_range + " (the integrator could not step past it: " + package + " " +
+           name + ")";
   std::string why = flag_meaning(bare, max_steps) + " (" + package + " " +
                     (name.empty() ? "flag" : name) + ", " + std::to_string(flag) + ")";
   if (!module_message.empty()) why += " [" + module_message + "]";
@@ -110,6 +115,7 @@ class SundialsIntegrator : public Integrator {
     const long left = max_steps_ - stats().steps;
     if (left <= 0) return -1;  // *_TOO_MUCH_WORK
     context_->nonfinite_evaluations = 0;
+    context_->out_of_range.clear();
     const int flag = evolve(tout, tstop, y, t, left);
     if (flag >= 0 && !finite(y)) return kNonFiniteState;
     return flag;

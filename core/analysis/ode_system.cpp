@@ -9,6 +9,8 @@
 #include <exception>
 #include <string>
 
+#include "core/analysis/deformation_check.hpp"
+
 namespace beamrail {
 namespace {
 
@@ -39,6 +41,18 @@ int non_finite(OdeContext* c, double t, const char* what) {
   return -1;
 }
 
+// An element outside the range of its law at time t (core/analysis/deformation_check.hpp):
+// recoverable (a trial state of the Newton iteration may overshoot; the integrator retries with a
+// smaller step) until kNonFiniteLimit of them within one call of the integrator, then the end.
+int out_of_range(OdeContext* c, double t) {
+  char when[48];
+  std::snprintf(when, sizeof when, "at t = %.9g s, ", t);
+  c->out_of_range = when + element_out_of_range(c->model, c->data);
+  if (++c->nonfinite_evaluations < kNonFiniteLimit) return 1;
+  c->divergence = c->out_of_range;
+  return -1;
+}
+
 }  // namespace
 
 int ode_rhs(double t, N_Vector y, N_Vector ydot, void* user_data) {
@@ -53,6 +67,7 @@ int ode_rhs(double t, N_Vector y, N_Vector ydot, void* user_data) {
     state_derivative(c->model, c->data, t, s, f);
     for (long i = 0; i < n; ++i)
       if (!std::isfinite(f[i])) return non_finite(c, t, "forces");
+    if (c->data.out_of_range) return out_of_range(c, t);
     return 0;
   });
 }

@@ -39,6 +39,10 @@ struct OdeContext {
   bool interrupted = false;        // a stop was requested (stop_request.hpp)
   long nonfinite_evaluations = 0;  // in the current call of the integrator
   std::string divergence;          // why the run was ended as diverged (non-finite forces)
+  // The last state of the current call with an element outside the range of its law (a
+  // recoverable failure of the right-hand side), described: why the integrator gave up, if it
+  // did so over failures of the right-hand side.
+  std::string out_of_range;
 
   // True, with timed_out or interrupted set, when the run must end now.
   bool should_stop() {

@@ -2,6 +2,8 @@
 // bodies, in either force formulation, with stiffness-proportional damping.
 #pragma once
 
+#include <type_traits>
+
 #include "core/model/element_kinematics.hpp"
 #include "core/model/stiffness.hpp"
 
@@ -25,12 +27,22 @@ LocalForces<S> beam_law(const Beam& beam, const Vec6T<S>& s) {
   return out;
 }
 
+// Whether a beam's configuration lies outside the range of its law: an angle beyond
+// kElementAngleLimit, or point 2 at or behind point 1 along the axis (compressed through zero
+// length: inverted).
+inline bool beam_out_of_range(const ElementFrames<double>& f) {
+  return !(f.xi(0) > 0.0) || !(f.phi.cwiseAbs().maxCoeff() <= kElementAngleLimit);
+}
+
 // Adds the beam's wrenches (force, moment about the centre of mass; global) on body 1 and body 2
-// to w1 and w2 and returns its strain energy 1/2 delta^T K2 delta [J].
+// to w1 and w2 and returns its strain energy 1/2 delta^T K2 delta [J]. For doubles, sets
+// *out_of_range (when given) if the configuration is outside the law's range.
 template <class T>
-T beam_wrenches(const Beam& beam, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1,
-                Vec6T<T>& w2) {
+T beam_wrenches(const Beam& beam, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
+                bool* out_of_range = nullptr) {
   const ElementFrames<T> f = element_frames(beam.ends, b1, b2);
+  if constexpr (std::is_same_v<T, double>)
+    if (out_of_range && beam_out_of_range(f)) *out_of_range = true;
   Vec6T<T> s;
   s << f.xi, f.phi;
   const LocalForces<T> law = beam_law(beam, s);

@@ -24,6 +24,9 @@ struct Data {
   double elastic_energy = 0.0;     // sum of element strain energies [J]
   std::vector<char> rail_floored;  // per rail: |l| was at min_length in the last evaluation
   std::vector<char> rail_floored_ever;  // per rail: ... in any evaluation so far
+  // An element outside the range of its law (beam_out_of_range, rail_out_of_range) in the last
+  // evaluation of the wrenches.
+  bool out_of_range = false;
 
   // Tangent blocks, one per model.pattern block (row body, column body):
   std::vector<Mat6> stiffness;  // d wrench_row / d (dc, dtheta)_col  [N/m, N, N m]

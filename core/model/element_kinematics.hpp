@@ -24,6 +24,11 @@
 
 namespace beamrail {
 
+// The largest element angle |phi_i| inside the range of the element laws [rad]: the angles'
+// derivative T is singular at a bending angle of pi/2, and the law repeats where an angle passes
+// pi (core/analysis/deformation_check.hpp says what the analyses do beyond it).
+inline constexpr double kElementAngleLimit = 1.5;
+
 // Position, orientation and velocity of a body, all in global axes. The centre is held as its
 // displacement u from the body's reference position (in a Model: Body::position, the initial
 // centre), never as absolute coordinates: an element's chord is the difference of its bodies'

@@ -38,20 +38,23 @@ void compute_wrenches(const Model& model, Data& data, double t, double load_fact
   for (Vec6& w : data.wrench) w.setZero();
   add_loads(model, data, t, load_factor);
   double energy = 0.0;
+  bool out = false;
   for (const Beam& e : model.beams) {
     const int i1 = e.ends.body1, i2 = e.ends.body2;
-    energy += beam_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2]);
+    energy +=
+        beam_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2], &out);
   }
   for (size_t r = 0; r < model.rails.size(); ++r) {
     const Rail& e = model.rails[r];
     const int i1 = e.ends.body1, i2 = e.ends.body2;
     bool floored = false;
-    energy +=
-        rail_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2], &floored);
+    energy += rail_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2],
+                            &floored, &out);
     data.rail_floored[r] = floored;
     if (floored) data.rail_floored_ever[r] = 1;
   }
   data.elastic_energy = energy;
+  data.out_of_range = out;
   ++data.n_wrench_evaluations;
 }
 

@@ -8,8 +8,9 @@
 namespace beamrail {
 
 // Sets data.wrench (every body; global force and moment about the centre of mass),
-// data.elastic_energy and data.rail_floored at time t [s] from data.pose. Gravity and loads are
-// scaled by load_factor (static load stepping); t = +infinity gives every load its final value.
+// data.elastic_energy, data.rail_floored and data.out_of_range at time t [s] from data.pose.
+// Gravity and loads are scaled by load_factor (static load stepping); t = +infinity gives every
+// load its final value.
 void compute_wrenches(const Model& model, Data& data, double t, double load_factor = 1.0);
 
 // Sets data.stiffness (and data.damping when with_velocity) for every block of model.pattern at

@@ -4,7 +4,9 @@
 // rail has no torsional stiffness either.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "core/model/element_kinematics.hpp"
 #include "core/model/stiffness.hpp"
@@ -70,12 +72,28 @@ LocalForces<S> rail_law(const Rail& rail, const Vec6T<S>& s, bool* floored) {
   return out;
 }
 
+// The largest angle of a rail that counts as deformation (a cylindrical rail's twist is free).
+inline double rail_angle(const Rail& rail, const ElementFrames<double>& f) {
+  const double bending = std::max(std::abs(f.phi(1)), std::abs(f.phi(2)));
+  return rail.type == RailType::kCylindrical ? bending : std::max(bending, std::abs(f.phi(0)));
+}
+
+// Whether a rail's configuration lies outside the range of its law: an angle beyond
+// kElementAngleLimit, or the carriage outside the rail's travel.
+inline bool rail_out_of_range(const Rail& rail, const ElementFrames<double>& f) {
+  return !(rail_angle(rail, f) <= kElementAngleLimit) ||
+         !(f.xi(0) >= rail.travel_min && f.xi(0) <= rail.travel_max);
+}
+
 // Adds the rail's wrenches on body 1 (the rail) and body 2 (the carriage) to w1 and w2 and returns
-// the strain energy 1/2 delta^T K2(l) delta [J]. Sets *floored when |l| hit min_length.
+// the strain energy 1/2 delta^T K2(l) delta [J]. Sets *floored when |l| hit min_length; for
+// doubles, sets *out_of_range (when given) if the configuration is outside the law's range.
 template <class T>
 T rail_wrenches(const Rail& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
-                bool* floored) {
+                bool* floored, bool* out_of_range = nullptr) {
   const ElementFrames<T> f = element_frames(rail.ends, b1, b2, rail.type == RailType::kCylindrical);
+  if constexpr (std::is_same_v<T, double>)
+    if (out_of_range && rail_out_of_range(rail, f)) *out_of_range = true;
   Vec6T<T> s;
   s << f.xi, f.phi;
   const LocalForces<T> law = rail_law(rail, s, floored);

@@ -1,0 +1,133 @@
+// Transient runs that leave the range of the element laws end as failed, naming the element and
+// the time: an element twisted past the singularity of its angles (and on to pi, where its law
+// repeats and a conservative run used to gain energy), a beam compressed through zero length, a
+// carriage running off its rail's travel. A run that stays inside keeps its energy.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/analysis/transient.hpp"
+#include "tests/support/scene_builder.hpp"
+#include "tests/support/transient_run.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::Scene;
+using testing::simulate;
+constexpr double kE = 2.1e11, kG = 8.0769e10;
+
+TransientOptions options(const std::string& method, double t_end, double output_step) {
+  TransientOptions o;
+  o.t_end = t_end;
+  o.output_step = output_step;
+  o.integrator.method = method;
+  o.integrator.rtol = 1e-8;
+  o.integrator.atol = 1e-10;
+  o.max_seconds = 60.0;  // a guard: every run here ends in well under a second
+  return o;
+}
+
+// A 1 m massless steel shaft (10 mm square, G Ix = 114 N m) holding a disc of polar inertia 1e-4
+// spun about the shaft's axis at w0: it twists by up to w0 sqrt(J L / G Ix) (3.75 rad for 4000
+// rad/s), conservatively. Past 1.5 rad the run fails, naming the beam; at 1,000 rad/s (0.94 rad)
+// it runs through and conserves energy. (Passing pi, the run once gained 22 % energy.)
+TEST(TransientRange, ShaftTwistedBeyondTheLawsRangeEndsTheRun) {
+  for (const std::string method : {"bdf", "dirk", "erk"}) {
+    for (const double w0 : {1000.0, 4000.0}) {
+      Scene s;
+      s.material("steel", kE, kG).square("sq10", 0.01);
+      s.body("disc", 1.0, Vec3(1e-4, 1e-2, 1e-2), Vec3(1, 0, 0));
+      s.last_body()["angular_velocity"] = testing::vec(w0, 0, 0);
+      s.beam("shaft", "ground", "disc", Vec3::Zero(), Vec3(1, 0, 0), "steel", "sq10");
+      const Model model = s.model();
+      const auto run = simulate(model, options(method, 0.02, 1e-4));
+      double drift = 0.0;
+      const double e0 = run.samples.front().sample.energy();
+      for (const auto& snap : run.samples)
+        drift = std::max(drift, std::abs(snap.sample.energy() / e0 - 1));
+      std::printf("%s, w0 = %.0f rad/s: %s at t = %.5f s, energy drift %.1e%s%s\n", method.c_str(),
+                  w0, run.result.ok ? "ok" : "failed", run.result.t_reached, drift,
+                  run.result.ok ? "" : ": ", run.result.message.c_str());
+      if (w0 < 2000) {
+        EXPECT_TRUE(run.result.ok) << run.result.message;
+        EXPECT_LT(drift, 1e-5);
+      } else {
+        EXPECT_FALSE(run.result.ok);
+        EXPECT_NE(run.result.message.find("beam \"shaft\" turned"), std::string::npos)
+            << run.result.message;
+        // It stops within the quarter period in which the twist first reaches 1.5 rad.
+        EXPECT_LT(run.result.t_reached, 0.25 * 2 * 3.14159265 * std::sqrt(1e-4 / 114.0) * 1.01);
+        EXPECT_LT(drift, 1e-5);  // nothing gained before the end
+      }
+    }
+  }
+}
+
+// A 1 kg body at the end of a 0.1 m steel beam (10 mm square, E S / l = 2.1e8 N/m) pushed along
+// the beam at v0: the linear axial law would compress it by v0 / w, w = 1.449e4 rad/s: 0.0345 m at
+// 500 m/s (it does, to the sampling), 0.138 m at 2,000 m/s, more than the beam's length: the run
+// fails when the beam inverts.
+TEST(TransientRange, BeamCompressedThroughZeroLengthEndsTheRun) {
+  const double w = std::sqrt(kE * 1e-4 / 0.1);
+  for (const double v0 : {500.0, 2000.0}) {
+    Scene s;
+    s.material("steel", kE, kG).square("sq10", 0.01);
+    s.body("block", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.1, 0, 0));
+    s.last_body()["velocity"] = testing::vec(-v0, 0, 0);
+    s.beam("strut", "ground", "block", Vec3::Zero(), Vec3(0.1, 0, 0), "steel", "sq10");
+    const auto run = simulate(s.model(), options("bdf", 2e-4, 1e-6));
+    double closest = 1.0;
+    for (const auto& snap : run.samples) closest = std::min(closest, snap.c[1].x());
+    std::printf("v0 = %.0f m/s: %s, closest approach %.4f m%s%s\n", v0,
+                run.result.ok ? "ok" : "failed", closest, run.result.ok ? "" : ": ",
+                run.result.message.c_str());
+    if (v0 < 1000) {
+      EXPECT_TRUE(run.result.ok) << run.result.message;
+      EXPECT_NEAR((0.1 - closest) / (v0 / w), 1.0, 1e-4);
+    } else {
+      EXPECT_FALSE(run.result.ok);
+      EXPECT_NE(run.result.message.find("compressed through zero length"), std::string::npos)
+          << run.result.message;
+      EXPECT_GT(closest, 0.0);  // no inverted state was reported
+    }
+  }
+}
+
+// A carriage on a rail of travel [0, 0.5] m sent along it at 1 m/s from 0.4 m: it leaves the
+// travel at t = 0.1 s, where the run fails. Without a travel it runs on to 100 m from point 1
+// (250 times its initial distance) and the run warns.
+TEST(TransientRange, CarriageLeavingItsTravelEndsTheRun) {
+  for (const bool travel : {true, false}) {
+    Scene s;
+    s.material("steel", kE, kG).circle("rod", 0.02);
+    s.body("carriage", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.4, 0, 0));
+    s.last_body()["velocity"] = testing::vec(travel ? 1.0 : 1000.0, 0, 0);
+    s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.4, 0, 0), "steel",
+           "rod");
+    if (travel) s.last_rail()["travel"] = {0.0, 0.5};
+    const auto run = simulate(s.model(), options("bdf", 0.2, 1e-3));
+    std::printf("travel %s: %s at t = %.4f s, carriage at %.3f m%s%s\n",
+                travel ? "[0, 0.5]" : "none", run.result.ok ? "ok" : "failed", run.result.t_reached,
+                run.samples.back().c[1].x(), run.result.ok ? "" : ": ", run.result.message.c_str());
+    for (const std::string& w : run.result.warnings) std::printf("  warning: %s\n", w.c_str());
+    if (travel) {
+      EXPECT_FALSE(run.result.ok);
+      EXPECT_NE(run.result.message.find("left the rail"), std::string::npos);
+      EXPECT_NEAR(run.result.t_reached, 0.1, 2e-3);
+    } else {
+      ASSERT_TRUE(run.result.ok) << run.result.message;
+      bool warned = false;
+      for (const std::string& w : run.result.warnings)
+        warned |= w.find("times its initial distance") != std::string::npos;
+      EXPECT_TRUE(warned);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace beamrail

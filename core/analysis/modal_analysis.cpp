@@ -216,17 +216,26 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
   try {
     compute_wrenches(model, data, options.time, options.load_factor);
     compute_tangent(model, data, options.time, false, options.load_factor);
-    const SparseMatrix s = stiffness_matrix(model, data);
-    const SparseMatrix k = -s;
-    const SparseMatrix kt = SparseMatrix(k.transpose());
-    const SparseMatrix sym = 0.5 * (k + kt);
     const SparseMatrix m = mass_matrix(model, data);
-    // Asymmetry of the mass-normalized operator (1/s^2 in every entry): a plain norm of K mixes
-    // N/m with N m, so its value would depend on the unit of length.
-    const Eigen::VectorXd d = Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse();
-    const SparseMatrix kn = d.asDiagonal() * k * d.asDiagonal();
-    const double norm = kn.norm();
-    result.asymmetry = norm > 0.0 ? (kn - SparseMatrix(kn.transpose())).norm() / norm : 0.0;
+    SparseMatrix sym;  // the symmetric part of K = -S
+    {
+      const SparseMatrix s = stiffness_matrix(model, data);
+      const SparseMatrix st = s.transpose();
+      sym = -0.5 * (s + st);
+      // Asymmetry of the mass-normalized operator (1/s^2 in every entry): a plain norm of K
+      // mixes N/m with N m, so its value would depend on the unit of length. Entry by entry,
+      // without forming the scaled matrices (a 100,000-body chain has 1e7 entries).
+      const Eigen::VectorXd d = Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse();
+      double norm = 0.0, skew = 0.0;
+      for (Eigen::Index c = 0; c < s.outerSize(); ++c)
+        for (SparseMatrix::InnerIterator it(s, c); it; ++it) {
+          const double w = d(it.row()) * d(it.col());
+          norm += w * w * it.value() * it.value();
+          const double a = w * (it.value() - st.coeff(it.row(), it.col()));
+          skew += a * a;
+        }
+      result.asymmetry = norm > 0.0 ? std::sqrt(skew / norm) : 0.0;
+    }
     const int wanted = std::max(1, options.modes);
     const Eigen::Index n = model.n_dofs;
     const bool dense = options.solver == EigenSolverKind::kDense ||
@@ -258,7 +267,13 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     }
     result.ok = true;
     // Resolution of each non-rigid mode against the rounding of the stiffness terms.
-    const SparseMatrix k_abs = sym.cwiseAbs();
+    const auto abs_times = [&sym](const Eigen::VectorXd& x) {
+      Eigen::VectorXd out = Eigen::VectorXd::Zero(x.size());
+      for (Eigen::Index c = 0; c < sym.outerSize(); ++c)
+        for (SparseMatrix::InnerIterator it(sym, c); it; ++it)
+          out(it.row()) += std::abs(it.value()) * std::abs(x(c));
+      return out;
+    };
     const Eigen::VectorXd weight = Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse();
     double worst = 0.0;
     int worst_mode = 0, number = 0;
@@ -266,8 +281,7 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
       if (mode.kind == Mode::Kind::kRigid) continue;
       ++number;
       mode.noise = std::numeric_limits<double>::epsilon() *
-                   weight.cwiseProduct(k_abs * mode.shape.cwiseAbs()).norm() /
-                   std::abs(mode.eigenvalue);
+                   weight.cwiseProduct(abs_times(mode.shape)).norm() / std::abs(mode.eigenvalue);
       if (!(mode.noise <= worst)) worst = mode.noise, worst_mode = number;
     }
     const std::string noise_text = "mode " + std::to_string(worst_mode) +

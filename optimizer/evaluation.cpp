@@ -127,6 +127,7 @@ class Runner {
     report.rigid_modes = r.rigid_modes;
     report.modes = static_cast<int>(r.modes.size()) - r.rigid_modes;
     report.asymmetry = r.asymmetry;
+    report.nonsymmetric = r.nonsymmetric;
     add_warnings(r.warnings);
     if (!r.ok) return report;
     modal_responses(study_, r, ev_.responses);

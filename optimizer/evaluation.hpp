@@ -48,6 +48,7 @@ struct AnalysisReport {
   double shift = 0.0;  // of the inverse problem [1/s^2]
   double noise = 0.0;  // largest Mode::noise among the modes found
   double asymmetry = 0.0;
+  bool nonsymmetric = false;  // the non-symmetric eigenproblem (torques of fixed direction)
 };
 
 struct Evaluation {

@@ -84,6 +84,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
                         {"last_correction", json_number(r.correction)},
                         {"singular_directions", r.singular_directions},
                         {"negative_stiffness_directions", r.negative_directions},
+                        {"flutter_pairs", r.flutter_pairs},
                         {"wall_seconds", r.wall_seconds}};
       if (a.type == "static")
         j.update(st);
@@ -98,6 +99,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["shift"] = json_number(a.shift);
       j["largest_noise"] = json_number(a.noise);
       j["stiffness_asymmetry"] = json_number(a.asymmetry);
+      j["eigenproblem"] = a.nonsymmetric ? "non-symmetric" : "symmetric";
     }
     analyses.push_back(j);
   }

@@ -1,10 +1,13 @@
 #include "core/analysis/modal_analysis.hpp"
 
+#include <Spectra/GenEigsRealShiftSolver.h>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <complex>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -55,10 +58,12 @@ class ShiftSolve {
   Eigen::Index rows() const { return k_.rows(); }
   Eigen::Index cols() const { return k_.cols(); }
   void set_shift(double sigma) {
+    budget_.check();
     const SparseMatrix a = k_ - sigma * m_;
     ldlt_.compute(a);
     if (ldlt_.info() != Eigen::Success)
       throw std::runtime_error("the shifted stiffness K + mu M could not be factored");
+    budget_.check();
   }
   void perform_op(const double* x, double* y) const {
     budget_.check();
@@ -99,6 +104,105 @@ bool solve_lanczos(const SparseMatrix& k, const SparseMatrix& m, double shift, E
   if (eigs.info() != Spectra::CompInfo::Successful) return false;
   out.values = eigs.eigenvalues();
   out.vectors = eigs.eigenvectors();
+  return true;
+}
+
+// Whether torques (of fixed direction) load the state linearized.
+bool loaded_by_torques(const Model& model, const ModalOptions& options) {
+  if (options.load_factor == 0.0) return false;
+  for (const Load& load : model.loads)
+    if (load.kind == LoadKind::kTorque && load.value != Vec3::Zero()) return true;
+  return false;
+}
+
+// y = L^T (K - sigma M)^-1 L x = (A - sigma I)^-1 x for A = L^-1 K L^-T, M = L L^T: the
+// shift-invert operator of the non-symmetric problem for Spectra's Arnoldi, by a sparse LU.
+class NonsymmetricShiftSolve {
+ public:
+  using Scalar = double;
+  NonsymmetricShiftSolve(const SparseMatrix& k, const SparseMatrix& m, const SparseMatrix& l,
+                         const Budget& budget)
+      : k_(k), m_(m), l_(l), budget_(budget) {}
+  Eigen::Index rows() const { return k_.rows(); }
+  Eigen::Index cols() const { return k_.cols(); }
+  void set_shift(double sigma) {
+    budget_.check();
+    SparseMatrix a = k_ - sigma * m_;
+    a.makeCompressed();
+    lu_.compute(a);
+    if (lu_.info() != Eigen::Success)
+      throw std::runtime_error("the shifted stiffness K + mu M could not be factored");
+    budget_.check();
+  }
+  void perform_op(const double* x, double* y) const {
+    budget_.check();
+    const Eigen::VectorXd lx = l_ * Eigen::Map<const Eigen::VectorXd>(x, rows());
+    Eigen::Map<Eigen::VectorXd>(y, rows()) = l_.transpose() * lu_.solve(lx);
+  }
+
+ private:
+  const SparseMatrix& k_;
+  const SparseMatrix& m_;
+  const SparseMatrix& l_;
+  const Budget& budget_;
+  Eigen::SparseLU<SparseMatrix> lu_;
+};
+
+// The eigenpairs of the non-symmetric K x = w^2 M x (K = -S at a state under torques of fixed
+// direction, which do no conservative work): with M = L L^T, A = L^-1 K L^-T has the same
+// eigenvalues and the eigenvectors L^T x. All pairs densely, or the `count` nearest -shift by
+// Arnoldi with shift-invert. Real pairs go to `out`; complex ones (flutter: a vibration that
+// grows) are counted in *complex_pairs (one per conjugate pair) with the largest
+// |Im w^2| / |w^2| in *growth. False when the eigensolver did not converge.
+bool solve_nonsymmetric(const SparseMatrix& k, const SparseMatrix& m, double shift,
+                        Eigen::Index count, bool dense, const Budget& budget, Eigenpairs& out,
+                        int* complex_pairs, double* growth) {
+  const Eigen::Index n = k.rows();
+  const Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> mf(m);
+  if (mf.info() != Eigen::Success)
+    throw std::runtime_error("the mass matrix is not positive definite");
+  const SparseMatrix l = mf.matrixL();
+  Eigen::VectorXcd values;
+  Eigen::MatrixXcd vectors;
+  if (dense || n < count + 3) {
+    if (!solve_dense_nonsymmetric(Eigen::MatrixXd(k), Eigen::MatrixXd(m), values, &vectors))
+      return false;
+  } else {
+    const Eigen::Index nev = std::min<Eigen::Index>(n - 2, count);
+    const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
+    NonsymmetricShiftSolve op(k, m, l, budget);
+    Spectra::GenEigsRealShiftSolver<NonsymmetricShiftSolve> eigs(op, nev, ncv, -shift);
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+    if (eigs.info() != Spectra::CompInfo::Successful) return false;
+    values = eigs.eigenvalues();
+    vectors = eigs.eigenvectors();
+  }
+  // A real eigenvalue of a real matrix may carry a rounding-level imaginary part; 1e-6 of its
+  // size (a growth of the amplitude by 3e-6 rad per radian of vibration) tells them apart.
+  std::vector<Eigen::Index> real;
+  *complex_pairs = 0;
+  *growth = 0.0;
+  for (Eigen::Index i = 0; i < values.size(); ++i) {
+    const double size = std::max(std::abs(values(i)), shift);
+    if (std::abs(values(i).imag()) <= 1e-6 * size) {
+      real.push_back(i);
+    } else if (values(i).imag() > 0.0) {
+      ++*complex_pairs;
+      *growth = std::max(*growth, std::abs(values(i).imag()) / std::abs(values(i)));
+    }
+  }
+  out.values.resize(static_cast<Eigen::Index>(real.size()));
+  out.vectors.resize(n, static_cast<Eigen::Index>(real.size()));
+  for (size_t j = 0; j < real.size(); ++j) {
+    Eigen::VectorXcd psi = vectors.col(real[j]);
+    Eigen::Index big = 0;
+    psi.cwiseAbs().maxCoeff(&big);
+    psi *= std::conj(psi(big)) / std::abs(psi(big));  // the phase that makes it real
+    out.values(static_cast<Eigen::Index>(j)) = values(real[j]).real();
+    out.vectors.col(static_cast<Eigen::Index>(j)) =
+        mf.matrixU().solve(Eigen::VectorXd(psi.real()));
+  }
   return true;
 }
 
@@ -197,6 +301,20 @@ bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& 
   return true;
 }
 
+bool solve_dense_nonsymmetric(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m,
+                              Eigen::VectorXcd& values, Eigen::MatrixXcd* vectors) {
+  const Eigen::LLT<Eigen::MatrixXd> mf(m);
+  if (mf.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd l = mf.matrixL();
+  Eigen::MatrixXd a = l.triangularView<Eigen::Lower>().solve(k);
+  a = l.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd(a.transpose())).transpose();
+  const Eigen::EigenSolver<Eigen::MatrixXd> eig(a, vectors != nullptr);
+  if (eig.info() != Eigen::Success) return false;
+  values = eig.eigenvalues();
+  if (vectors) *vectors = eig.eigenvectors();
+  return true;
+}
+
 const Mode* elastic_mode(const ModalResult& result, int k) {
   int count = 0;
   for (const Mode& mode : result.modes)
@@ -217,25 +335,13 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     compute_wrenches(model, data, options.time, options.load_factor);
     compute_tangent(model, data, options.time, false, options.load_factor);
     const SparseMatrix m = mass_matrix(model, data);
-    SparseMatrix sym;  // the symmetric part of K = -S
-    {
-      const SparseMatrix s = stiffness_matrix(model, data);
-      const SparseMatrix st = s.transpose();
-      sym = -0.5 * (s + st);
-      // Asymmetry of the mass-normalized operator (1/s^2 in every entry): a plain norm of K
-      // mixes N/m with N m, so its value would depend on the unit of length. Entry by entry,
-      // without forming the scaled matrices (a 100,000-body chain has 1e7 entries).
-      const Eigen::VectorXd d = Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse();
-      double norm = 0.0, skew = 0.0;
-      for (Eigen::Index c = 0; c < s.outerSize(); ++c)
-        for (SparseMatrix::InnerIterator it(s, c); it; ++it) {
-          const double w = d(it.row()) * d(it.col());
-          norm += w * w * it.value() * it.value();
-          const double a = w * (it.value() - st.coeff(it.row(), it.col()));
-          skew += a * a;
-        }
-      result.asymmetry = norm > 0.0 ? std::sqrt(skew / norm) : 0.0;
-    }
+    // The symmetric part of K = -S, and the asymmetry of the mass-normalized operator (1/s^2 in
+    // every entry: a plain norm of K mixes N/m with N m, so its value would depend on the unit of
+    // length), block by block from the tangent's blocks and their transposes: no sparse
+    // transposes or sums (a 100,000-body chain has 1e7 entries).
+    const SparseMatrix sym = symmetric_stiffness(
+        model, data, Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse(), &result.asymmetry);
+    budget.check();
     const int wanted = std::max(1, options.modes);
     const Eigen::Index n = model.n_dofs;
     const bool dense = options.solver == EigenSolverKind::kDense ||
@@ -244,10 +350,22 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     result.shift = choose_shift(model, sym, m);
     const ElementDeformation deformation(model, data);
 
+    // Torques of fixed direction make the loaded state non-conservative and K non-symmetric
+    // at equilibrium: its own eigenproblem then, never its symmetric part (a cantilever bent by
+    // a tip torque: 3.485 Hz from the symmetric part, 3.645 Hz from the non-symmetric problem
+    // and from a transient). Rounding leaves ~1e-15.
+    const bool nonsymmetric = result.asymmetry > kModalAsymmetryLimit;
+    SparseMatrix k;
+    if (nonsymmetric) k = -stiffness_matrix(model, data);
+    int complex_pairs = 0;
+    double growth = 0.0;
     int found = 0;  // non-rigid modes among the pairs computed
     if (dense) {
       Eigenpairs pairs;
-      if (!solve_dense(sym, m, result.shift, pairs))
+      if (nonsymmetric
+              ? !solve_nonsymmetric(k, m, result.shift, n, true, budget, pairs, &complex_pairs,
+                                    &growth)
+              : !solve_dense(sym, m, result.shift, pairs))
         throw std::runtime_error("the dense eigensolver failed");
       budget.check();
       found = classify(pairs, m, deformation, result.shift, wanted, result);
@@ -258,12 +376,25 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
       for (Eigen::Index extra = 12;; extra *= 4) {
         const Eigen::Index count = std::min<Eigen::Index>(n - 1, wanted + extra);
         Eigenpairs pairs;
-        if (!solve_lanczos(sym, m, result.shift, count, budget, pairs))
-          throw std::runtime_error("the shift-invert eigensolver did not converge");
+        if (nonsymmetric ? !solve_nonsymmetric(k, m, result.shift, count, false, budget, pairs,
+                                               &complex_pairs, &growth)
+                         : !solve_lanczos(sym, m, result.shift, count, budget, pairs))
+          throw std::runtime_error(nonsymmetric
+                                       ? "the shift-invert eigensolver (Arnoldi) did not converge"
+                                       : "the shift-invert eigensolver did not converge");
         found = classify(pairs, m, deformation, result.shift, wanted, result);
-        if (found >= wanted || count >= n - 1) break;
+        if (found >= wanted || count >= n - 1 || complex_pairs > 0) break;
       }
       result.solver = "shift-invert";
+    }
+    result.nonsymmetric = nonsymmetric;
+    if (complex_pairs > 0) {
+      char growth_text[64];
+      std::snprintf(growth_text, sizeof growth_text, "%.2g", growth);
+      throw std::runtime_error(
+          "the configuration flutters: " + std::to_string(complex_pairs) +
+          " pair(s) of complex eigenvalues (|Im w^2| / |w^2| up to " + growth_text +
+          "), vibrations that grow: the torques of fixed direction feed them energy");
     }
     result.ok = true;
     // Resolution of each non-rigid mode against the rounding of the stiffness terms.
@@ -318,11 +449,11 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
           "the configuration is not a stable equilibrium: " + std::to_string(unstable) +
           " mode(s) with negative stiffness (buckling, or an unstable equilibrium)";
     }
-    if (result.ok && result.asymmetry > 1e-6)
-      result.warnings.push_back("the tangent stiffness is not symmetric (relative asymmetry " +
-                                std::to_string(result.asymmetry) +
-                                "): the configuration is not an equilibrium; its symmetric part "
-                                "was used");
+    if (result.ok && nonsymmetric && !loaded_by_torques(model, options))
+      result.warnings.push_back(
+          "the tangent stiffness is not symmetric (relative asymmetry " +
+          std::to_string(result.asymmetry) +
+          ") although no torque loads the scene: the configuration is not an equilibrium");
   } catch (const BudgetSpent&) {
     result.ok = false;
     result.timed_out = true;

@@ -10,6 +10,11 @@
 // with free bodies or rails may have rigid-body or mechanism modes: mu is then a small positive
 // multiple of the stiffness scale.
 //
+// Torques of fixed direction do no conservative work: at an equilibrium under them K is not
+// symmetric (relative asymmetry above kModalAsymmetryLimit), and the modes are those of the
+// non-symmetric problem (dense, or Arnoldi with shift-invert by a sparse LU); complex eigenvalues
+// (flutter) fail the analysis.
+//
 // A mode is rigid when it deforms no element (core/analysis/element_deformation.hpp), never by the
 // size of its eigenvalue: a soft elastic mode may have an eigenvalue 1e-20 of the stiffest one.
 #pragma once
@@ -62,7 +67,8 @@ struct ModalResult {
   std::vector<Mode> modes;  // ascending eigenvalue; rigid-body modes included, marked
   int rigid_modes = 0;
   double shift = 0.0;      // mu of the inverse problem [1/s^2]
-  double asymmetry = 0.0;  // |K - K^T| / |K| of D K D, D = diag(M)^-1/2, before symmetrizing
+  double asymmetry = 0.0;  // |K - K^T| / |K| of D K D, D = diag(M)^-1/2
+  bool nonsymmetric = false;  // asymmetry > kModalAsymmetryLimit: the non-symmetric problem solved
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
 };
@@ -75,6 +81,9 @@ struct ModalResult {
 inline constexpr double kModalNoiseError = 1e-3;
 inline constexpr double kModalNoiseWarning = 1e-4;
 inline constexpr double kModalNoiseLimit = 1.0;
+// Above this asymmetry the non-symmetric eigenproblem of K is solved (torques of fixed direction;
+// rounding leaves ~1e-15), below it the symmetric one of its symmetric part.
+inline constexpr double kModalAsymmetryLimit = 1e-10;
 
 // Solves the eigenproblem about the configuration in data.pose. Never throws.
 ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& data);
@@ -89,6 +98,12 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
 bool solve_dense_eigenproblem(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m,
                               Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                               double shift = -1.0);
+
+// Dense solution of the non-symmetric K x = lambda M x (M symmetric positive definite) through
+// A = L^-1 K L^-T, M = L L^T: every eigenvalue, and when `vectors` is given the eigenvectors
+// L^T x (columns). False when M is not positive definite or Eigen's solver fails.
+bool solve_dense_nonsymmetric(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m,
+                              Eigen::VectorXcd& values, Eigen::MatrixXcd* vectors = nullptr);
 
 // The k-th non-rigid mode (1-based; elastic or unstable), or nullptr.
 const Mode* elastic_mode(const ModalResult& result, int k);

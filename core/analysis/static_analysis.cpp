@@ -2,12 +2,14 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 
 #include "core/analysis/deformation_check.hpp"
+#include "core/analysis/modal_analysis.hpp"
 #include "core/model/element_kinematics.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
@@ -414,23 +416,70 @@ struct Newton {
   }
 };
 
-// Directions of negative stiffness at the equilibrium in data.pose: the negative pivots of an
-// LDL^T of the symmetric tangent (Sylvester's law of inertia), shifted by a small multiple of the
-// mass where rigid-body or mechanism directions (zero stiffness) may exist.
-int negative_directions(const Model& model, Data& data, double t) {
+// Stability of the equilibrium in data.pose.
+struct Stability {
+  int negative = 0;  // directions of negative stiffness (divergence)
+  int flutter = 0;   // pairs of vibrations that grow (non-conservative loads only)
+  bool divergence_only = false;  // only the parity of `negative` was judged (large, non-symmetric)
+};
+
+// Under conservative loads the tangent K is symmetric at an equilibrium: the negative pivots of
+// an LDL^T of K count its negative eigenvalues (Sylvester's law of inertia), shifted by a small
+// multiple of the mass where rigid-body or mechanism directions (zero stiffness) may exist.
+// Torques of fixed direction do no conservative work and make K non-symmetric: its symmetric part
+// says nothing then (a clamped beam bent into a circle by a tip torque is stable, its symmetric
+// part indefinite). The small vibrations M x'' + K x = 0 are bounded when every eigenvalue of
+// K x = lambda M x is real and positive: a negative one diverges, a complex pair flutters. Up to
+// kDenseStabilityLimit degrees of freedom all are computed; beyond, the sign of det K tells an
+// odd number of negative ones (a sparse LU), and flutter is not looked for.
+constexpr Eigen::Index kDenseStabilityLimit = 600;
+
+Stability stability(const Model& model, Data& data, double t) {
   compute_tangent(model, data, t, false, 1.0);
-  const Eigen::SparseMatrix<double> s = stiffness_matrix(model, data);
-  Eigen::SparseMatrix<double> k = -0.5 * (s + Eigen::SparseMatrix<double>(s.transpose()));
+  double asymmetry = 0.0;
+  Eigen::SparseMatrix<double> k =
+      symmetric_stiffness(model, data, stiffness_weights(model, data), &asymmetry);
+  const Eigen::SparseMatrix<double> m = mass_matrix(model, data);
+  double mu = 0.0;
   if (!held_by_beams(model)) {
-    const Eigen::SparseMatrix<double> m = mass_matrix(model, data);
     double scale = 0.0;
     for (Eigen::Index i = 0; i < k.rows(); ++i)
       scale = std::max(scale, std::abs(k.coeff(i, i)) / m.coeff(i, i));
-    k += (1e4 * kEps * (scale > 0.0 ? scale : 1.0)) * m;
+    mu = 1e4 * kEps * (scale > 0.0 ? scale : 1.0);
   }
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
-  if (ldlt.info() != Eigen::Success) return 1;  // a zero pivot: singular, not stable
-  return static_cast<int>((ldlt.vectorD().array() < 0.0).count());
+  Stability result;
+  if (asymmetry <= kModalAsymmetryLimit) {
+    k += mu * m;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
+    if (ldlt.info() != Eigen::Success) {  // a zero pivot: singular, not stable
+      result.negative = 1;
+      return result;
+    }
+    result.negative = static_cast<int>((ldlt.vectorD().array() < 0.0).count());
+    return result;
+  }
+  Eigen::SparseMatrix<double> full = -stiffness_matrix(model, data);
+  full += mu * m;
+  if (full.rows() <= kDenseStabilityLimit) {
+    Eigen::VectorXcd values;
+    if (!solve_dense_nonsymmetric(Eigen::MatrixXd(full), Eigen::MatrixXd(m), values)) {
+      result.negative = 1;
+      return result;
+    }
+    for (Eigen::Index i = 0; i < values.size(); ++i) {
+      const double size = std::max(std::abs(values(i)), mu);
+      if (std::abs(values(i).imag()) > 1e-6 * size)
+        result.flutter += values(i).imag() > 0.0;
+      else
+        result.negative += values(i).real() < 0.0;
+    }
+    return result;
+  }
+  full.makeCompressed();
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(full);
+  result.divergence_only = true;
+  result.negative = lu.info() != Eigen::Success || lu.signDeterminant() < 0.0 ? 1 : 0;
+  return result;
 }
 
 }  // namespace
@@ -511,15 +560,30 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
       }
     }
     if (result.ok && model.n_free() > 0) {
-      result.negative_directions = negative_directions(model, data, options.time);
+      const Stability stable = stability(model, data, options.time);
+      result.negative_directions = stable.negative;
+      result.flutter_pairs = stable.flutter;
       compute_wrenches(model, data, options.time, 1.0);
-      if (result.negative_directions > 0) {
+      if (stable.negative > 0 || stable.flutter > 0) {
         result.ok = false;
-        result.message =
-            "the equilibrium found is unstable: its tangent stiffness has " +
-            std::to_string(result.negative_directions) +
-            " direction(s) of negative stiffness (the structure buckles under these loads; the "
-            "state found is the unbuckled one)";
+        result.message = "the equilibrium found is unstable: ";
+        if (stable.negative > 0)
+          result.message += "its tangent stiffness has " + std::to_string(stable.negative) +
+                            " direction(s) of negative stiffness (the structure buckles or "
+                            "snaps under these loads, or the load path reached an unstable "
+                            "branch)";
+        if (stable.negative > 0 && stable.flutter > 0) result.message += "; ";
+        if (stable.flutter > 0)
+          result.message += std::to_string(stable.flutter) +
+                            " pair(s) of its small vibrations grow (flutter: the torques of "
+                            "fixed direction feed them energy)";
+      } else if (stable.divergence_only) {
+        result.warnings.push_back(
+            "torques of fixed direction make the tangent stiffness non-symmetric; with more than " +
+            std::to_string(kDenseStabilityLimit) +
+            " degrees of freedom only the sign of its determinant was checked (no divergence in "
+            "an odd number of directions), not flutter: a modal analysis about this state "
+            "checks every computed mode");
       }
     }
     if (result.ok && result.residual_norm > std::max(options.tolerance, 1e-6) * f_ref)
@@ -531,9 +595,13 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
                  result.correction));
     if (newton.singular > 0)
       result.warnings.push_back(
-          "the tangent stiffness has " + std::to_string(newton.singular) +
-          " direction(s) without stiffness (a free mechanism); the equilibrium closest to the "
-          "initial configuration along them is reported");
+          newton.held
+              ? "the tangent stiffness lost its stiffness in " + std::to_string(newton.singular) +
+                    " direction(s) along the load path (a limit or bifurcation point of the "
+                    "structure was passed); the equilibrium reached from it is reported"
+              : "the tangent stiffness has " + std::to_string(newton.singular) +
+                    " direction(s) without stiffness (a free mechanism); the equilibrium closest "
+                    "to the initial configuration along them is reported");
   } catch (const std::exception& e) {
     result.ok = false;
     result.message = e.what();

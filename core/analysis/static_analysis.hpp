@@ -13,6 +13,9 @@
 //    the load;
 //  - stability: the tangent stiffness at the equilibrium has no negative direction (a column
 //    loaded beyond its buckling load, whose straight state is an unstable equilibrium, fails);
+//    under torques of fixed direction (non-conservative, a non-symmetric tangent) no small
+//    vibration grows: no negative real or complex eigenvalue of K x = lambda M x (all of them up
+//    to 600 degrees of freedom, beyond only the sign of det K, with a warning);
 //  - range: every element is inside the range of its law (core/analysis/deformation_check.hpp),
 //    and no element's angles passed pi (where its law repeats) on the way: each Newton iterate
 //    turns a body by at most kMaxRotationStep, and an iterate that turns an element by more than
@@ -54,6 +57,7 @@ struct StaticResult {
   int load_steps = 0;            // load increments taken
   int singular_directions = 0;   // tangent directions with no stiffness (solved minimum-norm)
   int negative_directions = 0;   // of the tangent at the equilibrium (> 0: unstable, not ok)
+  int flutter_pairs = 0;  // growing vibration pairs under torques of fixed direction (> 0: not ok)
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
 };

@@ -2,6 +2,9 @@
 
 #include "core/model/rotation.hpp"
 
+#include <cmath>
+#include <vector>
+
 namespace beamrail {
 
 Eigen::VectorXd wrench_vector(const Model& model, const Data& data) {
@@ -23,6 +26,42 @@ Eigen::SparseMatrix<double> stiffness_matrix(const Model& model, const Data& dat
   Eigen::SparseMatrix<double> k(model.n_dofs, model.n_dofs);
   k.setFromTriplets(entries.begin(), entries.end());
   return k;
+}
+
+Eigen::SparseMatrix<double> symmetric_stiffness(const Model& model, const Data& data,
+                                                const Eigen::VectorXd& weight, double* asymmetry) {
+  const BlockPattern& pattern = model.pattern;
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(36 * pattern.blocks.size());
+  double norm = 0.0, skew = 0.0;
+  for (size_t b = 0; b < pattern.blocks.size(); ++b) {
+    const int r0 = kDofsPerBody * pattern.blocks[b].row;
+    const int c0 = kDofsPerBody * pattern.blocks[b].col;
+    const Mat6& s = data.stiffness[b];
+    const Mat6& t = data.stiffness[pattern.transposed[b]];
+    for (int c = 0; c < 6; ++c)
+      for (int r = 0; r < 6; ++r) {
+        const double w = weight(r0 + r) * weight(c0 + c);
+        norm += w * w * s(r, c) * s(r, c);
+        const double a = w * (s(r, c) - t(c, r));
+        skew += a * a;
+        entries.emplace_back(r0 + r, c0 + c, -0.5 * (s(r, c) + t(c, r)));
+      }
+  }
+  if (asymmetry) *asymmetry = norm > 0.0 ? std::sqrt(skew / norm) : 0.0;
+  Eigen::SparseMatrix<double> k(model.n_dofs, model.n_dofs);
+  k.setFromTriplets(entries.begin(), entries.end());
+  return k;
+}
+
+Eigen::VectorXd stiffness_weights(const Model& model, const Data& data) {
+  Eigen::VectorXd w(model.n_dofs);
+  for (int k = 0; k < model.n_free(); ++k)
+    for (int i = 0; i < kDofsPerBody; ++i) {
+      const double d = std::abs(data.stiffness[k](i, i));  // block k: free body k's diagonal
+      w(kDofsPerBody * k + i) = d > 0.0 && std::isfinite(d) ? 1.0 / std::sqrt(d) : 1.0;
+    }
+  return w;
 }
 
 Eigen::SparseMatrix<double> mass_matrix(const Model& model, const Data& data) {

@@ -17,6 +17,18 @@ Eigen::VectorXd wrench_vector(const Model& model, const Data& data);
 // d wrench / d (dc, dtheta) assembled from data.stiffness (n_dofs x n_dofs).
 Eigen::SparseMatrix<double> stiffness_matrix(const Model& model, const Data& data);
 
+// The symmetric part of the stiffness K = -S, -(S + S^T) / 2, block by block from data.stiffness
+// and the blocks' transposes (no sparse transposes or sums: a 100,000-body chain has 1e7
+// entries). *asymmetry = |W (S - S^T) W| / |W S W| (Frobenius norms, W = diag(weight)): with
+// weights that make the entries comparable (1 / sqrt(M_ii), or 1 / sqrt(|S_ii|)) it does not
+// depend on the units of length and angle. K is symmetric at an equilibrium under conservative
+// loads (rounding leaves ~1e-15); torques of fixed direction make it non-symmetric.
+Eigen::SparseMatrix<double> symmetric_stiffness(const Model& model, const Data& data,
+                                                const Eigen::VectorXd& weight, double* asymmetry);
+
+// Weights 1 / sqrt(|S_ii|) of symmetric_stiffness (1 where S_ii is 0), from data.stiffness.
+Eigen::VectorXd stiffness_weights(const Model& model, const Data& data);
+
 // The mass matrix in these coordinates: blocks m I and A J A^T (n_dofs x n_dofs).
 Eigen::SparseMatrix<double> mass_matrix(const Model& model, const Data& data);
 

@@ -105,6 +105,7 @@ struct BlockPattern {
   // a fixed body: [0] = (1,1), [1] = (1,2), [2] = (2,1), [3] = (2,2).
   std::vector<std::array<int, 4>> beam_blocks;
   std::vector<std::array<int, 4>> rail_blocks;
+  std::vector<int> transposed;  // per block, the index of the block (col, row)
 };
 
 struct Model {

@@ -766,5 +766,33 @@ TEST_F(DesignStudyRuns, ADesignPastItsBudgetIsATimeoutRowAndTheBatchGoesOn) {
   EXPECT_GE(std::stod(t.at(1, "wall_s")), 2.0);
 }
 
+// Static and modal analyses honour the design's budget too: under a 0.2 s budget the
+// 5,000-segment designs are timeout rows, loaded (the static analysis is stopped) or not (the
+// static analysis has nothing to do, the modal one is stopped), their neighbours ok. (Budgets
+// once stopped transients only: 1.3-2.1 s static and modal designs under 0.2 s were ok rows.)
+TEST_F(DesignStudyRuns, StaticAndModalDesignsPastTheirBudgetAreTimeoutRows) {
+  Json s = load_json(kStudies / "bending_tip_load.json");
+  s["scene"]["beams"][0]["segments"] = 10;
+  s["analyses"] = Json::parse(R"([{"type": "static"}, {"type": "modal", "modes": 2}])");
+  s["responses"] = Json::parse(R"({"f1": {"quantity": "frequency", "mode": 1}})");
+  s["study"] = Json::parse(R"({"type": "sweep", "sampling": "list", "max_seconds_per_design": 0.2,
+      "variables": [{"name": "segments", "pointer": "/scene/beams/0/segments"},
+                    {"name": "load", "pointer": "/scene/loads/0/value/1"}],
+      "rows": [[10, -1], [5000, -1], [5000, 0], [20, 0]]})");
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("budget.json", s), "out", {"-j", "1"}));
+  const Table t = read_table(dir_ / "out" / "samples.csv");
+  ASSERT_EQ(t.rows.size(), 4u);
+  const std::vector<std::string> expected = {"ok", "timeout", "timeout", "ok"};
+  for (size_t i = 0; i < 4; ++i) {
+    std::printf("%s segments, load %s: %s in %s s, f1 %s %s\n", t.at(i, "segments").c_str(),
+                t.at(i, "load").c_str(), t.at(i, "status").c_str(), t.at(i, "wall_s").c_str(),
+                t.at(i, "f1").c_str(), t.at(i, "message").c_str());
+    EXPECT_EQ(t.at(i, "status"), expected[i]) << i;
+  }
+  EXPECT_NE(t.at(1, "message").find("static analysis"), std::string::npos);
+  EXPECT_NE(t.at(2, "message").find("modal analysis"), std::string::npos);
+  EXPECT_EQ(t.at(2, "f1"), "nan");
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -148,6 +148,24 @@ class NonsymmetricShiftSolve {
   Eigen::SparseLU<SparseMatrix> lu_;
 };
 
+// The `count` eigenvalues of the non-symmetric K x = lambda M x nearest -shift by Arnoldi with
+// shift-invert (Spectra), M = L L^T; eigenvectors L^T x when `vectors` is given.
+bool arnoldi_nonsymmetric(const SparseMatrix& k, const SparseMatrix& m, const SparseMatrix& l,
+                          double shift, Eigen::Index count, const Budget& budget,
+                          Eigen::VectorXcd& values, Eigen::MatrixXcd* vectors) {
+  const Eigen::Index n = k.rows();
+  const Eigen::Index nev = std::min<Eigen::Index>(n - 2, count);
+  const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
+  NonsymmetricShiftSolve op(k, m, l, budget);
+  Spectra::GenEigsRealShiftSolver<NonsymmetricShiftSolve> eigs(op, nev, ncv, -shift);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+  if (eigs.info() != Spectra::CompInfo::Successful) return false;
+  values = eigs.eigenvalues();
+  if (vectors) *vectors = eigs.eigenvectors();
+  return true;
+}
+
 // The eigenpairs of the non-symmetric K x = w^2 M x (K = -S at a state under torques of fixed
 // direction, which do no conservative work): with M = L L^T, A = L^-1 K L^-T has the same
 // eigenvalues and the eigenvectors L^T x. All pairs densely, or the `count` nearest -shift by
@@ -167,16 +185,8 @@ bool solve_nonsymmetric(const SparseMatrix& k, const SparseMatrix& m, double shi
   if (dense || n < count + 3) {
     if (!solve_dense_nonsymmetric(Eigen::MatrixXd(k), Eigen::MatrixXd(m), values, &vectors))
       return false;
-  } else {
-    const Eigen::Index nev = std::min<Eigen::Index>(n - 2, count);
-    const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
-    NonsymmetricShiftSolve op(k, m, l, budget);
-    Spectra::GenEigsRealShiftSolver<NonsymmetricShiftSolve> eigs(op, nev, ncv, -shift);
-    eigs.init();
-    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
-    if (eigs.info() != Spectra::CompInfo::Successful) return false;
-    values = eigs.eigenvalues();
-    vectors = eigs.eigenvectors();
+  } else if (!arnoldi_nonsymmetric(k, m, l, shift, count, budget, values, &vectors)) {
+    return false;
   }
   // A real eigenvalue of a real matrix may carry a rounding-level imaginary part; 1e-6 of its
   // size (a growth of the amplitude by 3e-6 rad per radian of vibration) tells them apart.
@@ -313,6 +323,19 @@ bool solve_dense_nonsymmetric(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m
   values = eig.eigenvalues();
   if (vectors) *vectors = eig.eigenvectors();
   return true;
+}
+
+bool nonsymmetric_eigenvalues_near(const Eigen::SparseMatrix<double>& k,
+                                   const Eigen::SparseMatrix<double>& m, double shift,
+                                   Eigen::Index count, Eigen::VectorXcd& values) {
+  const Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> mf(m);
+  if (mf.info() != Eigen::Success) return false;
+  const SparseMatrix l = mf.matrixL();
+  try {
+    return arnoldi_nonsymmetric(k, m, l, shift, count, Budget{}, values, nullptr);
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 const Mode* elastic_mode(const ModalResult& result, int k) {

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <limits>
 #include <string>
 #include <vector>
@@ -104,6 +105,13 @@ bool solve_dense_eigenproblem(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m
 // L^T x (columns). False when M is not positive definite or Eigen's solver fails.
 bool solve_dense_nonsymmetric(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m,
                               Eigen::VectorXcd& values, Eigen::MatrixXcd* vectors = nullptr);
+
+// The `count` eigenvalues of the non-symmetric K x = lambda M x nearest -shift (Arnoldi with
+// shift-invert by a sparse LU; count < rows - 2). False when M is not positive definite, K + shift
+// M cannot be factored or Arnoldi does not converge.
+bool nonsymmetric_eigenvalues_near(const Eigen::SparseMatrix<double>& k,
+                                   const Eigen::SparseMatrix<double>& m, double shift,
+                                   Eigen::Index count, Eigen::VectorXcd& values);
 
 // The k-th non-rigid mode (1-based; elastic or unstable), or nullptr.
 const Mode* elastic_mode(const ModalResult& result, int k);

@@ -15,7 +15,7 @@
 //    loaded beyond its buckling load, whose straight state is an unstable equilibrium, fails);
 //    under torques of fixed direction (non-conservative, a non-symmetric tangent) no small
 //    vibration grows: no negative real or complex eigenvalue of K x = lambda M x (all of them up
-//    to 600 degrees of freedom, beyond only the sign of det K, with a warning);
+//    to 120 degrees of freedom; beyond, the 12 nearest zero and the sign of det K);
 //  - range: every element is inside the range of its law (core/analysis/deformation_check.hpp),
 //    and no element's angles passed pi (where its law repeats) on the way: each Newton iterate
 //    turns a body by at most kMaxRotationStep, and an iterate that turns an element by more than

@@ -7,10 +7,10 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
-#include <complex>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <numbers>
 #include <stdexcept>
@@ -210,8 +210,7 @@ bool solve_nonsymmetric(const SparseMatrix& k, const SparseMatrix& m, double shi
     psi.cwiseAbs().maxCoeff(&big);
     psi *= std::conj(psi(big)) / std::abs(psi(big));  // the phase that makes it real
     out.values(static_cast<Eigen::Index>(j)) = values(real[j]).real();
-    out.vectors.col(static_cast<Eigen::Index>(j)) =
-        mf.matrixU().solve(Eigen::VectorXd(psi.real()));
+    out.vectors.col(static_cast<Eigen::Index>(j)) = mf.matrixU().solve(Eigen::VectorXd(psi.real()));
   }
   return true;
 }
@@ -385,10 +384,9 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     int found = 0;  // non-rigid modes among the pairs computed
     if (dense) {
       Eigenpairs pairs;
-      if (nonsymmetric
-              ? !solve_nonsymmetric(k, m, result.shift, n, true, budget, pairs, &complex_pairs,
-                                    &growth)
-              : !solve_dense(sym, m, result.shift, pairs))
+      if (nonsymmetric ? !solve_nonsymmetric(k, m, result.shift, n, true, budget, pairs,
+                                             &complex_pairs, &growth)
+                       : !solve_dense(sym, m, result.shift, pairs))
         throw std::runtime_error("the dense eigensolver failed");
       budget.check();
       found = classify(pairs, m, deformation, result.shift, wanted, result);

@@ -67,8 +67,8 @@ struct ModalResult {
   std::string solver;       // "dense" or "shift-invert"
   std::vector<Mode> modes;  // ascending eigenvalue; rigid-body modes included, marked
   int rigid_modes = 0;
-  double shift = 0.0;      // mu of the inverse problem [1/s^2]
-  double asymmetry = 0.0;  // |K - K^T| / |K| of D K D, D = diag(M)^-1/2
+  double shift = 0.0;         // mu of the inverse problem [1/s^2]
+  double asymmetry = 0.0;     // |K - K^T| / |K| of D K D, D = diag(M)^-1/2
   bool nonsymmetric = false;  // asymmetry > kModalAsymmetryLimit: the non-symmetric problem solved
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;

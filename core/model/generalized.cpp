@@ -1,9 +1,9 @@
 #include "core/model/generalized.hpp"
 
-#include "core/model/rotation.hpp"
-
 #include <cmath>
 #include <vector>
+
+#include "core/model/rotation.hpp"
 
 namespace beamrail {
 

@@ -247,8 +247,8 @@ TEST(ModalExtremes, ElementDeformationTellsRigidFromElasticMotion) {
 
 // max_seconds stops a modal analysis between its phases and the eigensolver's operator
 // applications: a 30,000-segment chain (about 2 s unbudgeted) stops after its first phase
-// (assembling the symmetric part, ~0.4 s) under a 0.05 s budget. (Budgets once stopped transients only: static and modal
-// designs of 1.3-2.1 s ran to the end under 0.2 s and were reported ok.)
+// (assembling the symmetric part, ~0.4 s) under a 0.05 s budget. (Budgets once stopped transients
+// only: static and modal designs of 1.3-2.1 s ran to the end under 0.2 s and were reported ok.)
 TEST(ModalExtremes, TimeBudgetStopsTheAnalysis) {
   const Model model = tip_cantilever(30000);
   Data data(model);
@@ -259,8 +259,8 @@ TEST(ModalExtremes, TimeBudgetStopsTheAnalysis) {
   const ModalResult r = solve_modal(model, options, data);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("30,000 segments in 0.05 s: ok = %d, timed out = %d, %.3f s: %s\n", r.ok,
-              r.timed_out, wall, r.message.c_str());
+  std::printf("30,000 segments in 0.05 s: ok = %d, timed out = %d, %.3f s: %s\n", r.ok, r.timed_out,
+              wall, r.message.c_str());
   EXPECT_FALSE(r.ok);
   EXPECT_TRUE(r.timed_out);
   EXPECT_NE(r.message.find("time budget"), std::string::npos) << r.message;

@@ -170,9 +170,10 @@ TEST(NonConservativeLoads, StabilityOfANonSymmetricTangentDenseAndNearZero) {
       const Model model = s.model();
       Data data(model);
       const StaticResult r = solve_static(model, StaticOptions{}, data);
-      std::printf("%d segments, shaft at %.2f P_euler under 20 N m: ok = %d, %d negative, %d "
-                  "flutter %s\n",
-                  n, ratio, r.ok, r.negative_directions, r.flutter_pairs, r.message.c_str());
+      std::printf(
+          "%d segments, shaft at %.2f P_euler under 20 N m: ok = %d, %d negative, %d "
+          "flutter %s\n",
+          n, ratio, r.ok, r.negative_directions, r.flutter_pairs, r.message.c_str());
       EXPECT_FALSE(r.ok);
       EXPECT_GT(r.flutter_pairs, 0);
     }
@@ -214,8 +215,8 @@ TEST(NonConservativeLoads, FlutterGrowthRateIsTheTransients) {
     return a;
   };
   const double measured = std::log(envelope(7, 8) / envelope(4, 5)) / 3.0;
-  std::printf("growth rate: %.4f 1/s from the eigenvalues, %.4f 1/s in the transient\n",
-              predicted, measured);
+  std::printf("growth rate: %.4f 1/s from the eigenvalues, %.4f 1/s in the transient\n", predicted,
+              measured);
   EXPECT_GT(predicted, 0.1);
   EXPECT_NEAR(measured / predicted, 1.0, 0.15);
 

@@ -4,26 +4,10 @@
 #include <cmath>
 
 #include "core/model/element_kinematics.hpp"
+#include "core/model/element_tangent.hpp"
 #include "core/model/rotation.hpp"
 
 namespace beamrail {
-namespace {
-
-// The 6 x 12 map from (dc1, dtheta1, dc2, dtheta2) to (d xi, d phi).
-Eigen::Matrix<double, 6, 12> kinematic_map(const ElementFrames<double>& f) {
-  const Mat3 et = f.E1.transpose();
-  Eigen::Matrix<double, 6, 12> j = Eigen::Matrix<double, 6, 12>::Zero();
-  j.block<3, 3>(0, 0) = -et;
-  j.block<3, 3>(0, 3) = et * skew<double>(f.lever1);
-  j.block<3, 3>(0, 6) = et;
-  j.block<3, 3>(0, 9) = -et * skew<double>(f.R2);
-  const Mat3 tet = f.t * et;
-  j.block<3, 3>(3, 3) = -tet;
-  j.block<3, 3>(3, 9) = tet;
-  return j;
-}
-
-}  // namespace
 
 ElementDeformation::ElementDeformation(const Model& model, const Data& data) {
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);

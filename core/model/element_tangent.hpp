@@ -66,6 +66,21 @@ namespace beamrail {
 using Ad6 = Dual<6>;
 using Ad3 = Dual<3>;
 
+// The kinematic map J from the ends' (dc1, dtheta1, dc2, dtheta2) to the element's local
+// coordinates s = (xi, phi): J = [E^T (-I, [lever]x, I, -[R2]x); T E^T (0, -I, 0, I)].
+inline Eigen::Matrix<double, 6, 12> kinematic_map(const ElementFrames<double>& f) {
+  const Mat3 et = f.E1.transpose();
+  Eigen::Matrix<double, 6, 12> j = Eigen::Matrix<double, 6, 12>::Zero();
+  j.block<3, 3>(0, 0) = -et;
+  j.block<3, 3>(0, 3) = et * skew<double>(f.lever1);
+  j.block<3, 3>(0, 6) = et;
+  j.block<3, 3>(0, 9) = -et * skew<double>(f.R2);
+  const Mat3 tet = f.t * et;
+  j.block<3, 3>(3, 3) = -tet;
+  j.block<3, 3>(3, 9) = tet;
+  return j;
+}
+
 // The exact configuration Jacobian d(w1, w2)/d(dc1, dtheta1, dc2, dtheta2) of an element without
 // damping, in closed form (about 5x cheaper than differentiating the whole kernel):
 //   s = (xi, phi), ds = J dX with J = [E^T (-I, [lever]x, I, -[R2]x); T E^T (0, -I, 0, I)];
@@ -78,14 +93,7 @@ Mat12 configuration_jacobian(const ElementFrames<double>& f, Formulation formula
                              bool twist_free, Law&& law) {
   const Mat3& e = f.E1;
   const Mat3 et = e.transpose();
-  Eigen::Matrix<double, 6, 12> j = Eigen::Matrix<double, 6, 12>::Zero();
-  j.block<3, 3>(0, 0) = -et;
-  j.block<3, 3>(0, 3) = et * skew<double>(f.lever1);
-  j.block<3, 3>(0, 6) = et;
-  j.block<3, 3>(0, 9) = -et * skew<double>(f.R2);
-  const Mat3 tet = f.t * et;
-  j.block<3, 3>(3, 3) = -tet;
-  j.block<3, 3>(3, 9) = tet;
+  const Eigen::Matrix<double, 6, 12> j = kinematic_map(f);
 
   Vec6T<Ad6> s;
   for (int i = 0; i < 3; ++i) s(i) = Ad6(f.xi(i), i), s(3 + i) = Ad6(f.phi(i), 3 + i);

@@ -1,5 +1,5 @@
-// Design studies (SPEC.md "study"): design variables addressing numbers of the study file by JSON
-// pointer, sweeps over them, and NLopt optimization of the responses.
+// Design studies (docs/study_files.md "study"): design variables addressing numbers of the study
+// file by JSON pointer, sweeps over them, and NLopt optimization of the responses.
 #pragma once
 
 #include <optional>

@@ -1,5 +1,5 @@
-// The result tables of a single run (SPEC.md "Outputs"): time series, static displacements,
-// element forces, modes and mode shapes.
+// The result tables of a single run (docs/study_files.md "Outputs"): time series, static
+// displacements, element forces, modes and mode shapes.
 #pragma once
 
 #include <chrono>

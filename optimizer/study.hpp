@@ -1,5 +1,6 @@
-// Study loading (SPEC.md "Study file"): the scene, the analyses to run, the named responses, and
-// the optional design study, validated strictly. JSON stays here: what comes out is plain C++.
+// Study loading (docs/study_files.md "Study file"): the scene, the analyses to run, the named
+// responses, and the optional design study, validated strictly. JSON stays here: what comes out is
+// plain C++.
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,5 @@
-// summary.json (SPEC.md "Outputs"): what was modelled, what each analysis cost, the responses,
-// the status and the warnings of a run.
+// summary.json (docs/study_files.md "Outputs"): what was modelled, what each analysis cost, the
+// responses, the status and the warnings of a run.
 #pragma once
 
 #include <nlohmann/json.hpp>

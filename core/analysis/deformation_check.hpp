@@ -1,4 +1,4 @@
-// The range of the element laws (DESIGN.md §1). The beam and rail laws take the relative rotation
+// The range of the element laws (docs/model.md). The beam and rail laws take the relative rotation
 // angles phi of an element as if they were small, and measure them as three atan2 angles of the
 // relative rotation: the law is smooth only while every |phi_i| < pi/2 (the angles' derivative T
 // is singular at a bending angle of pi/2) and jumps where an angle passes pi (kElementAngleLimit,

@@ -1,8 +1,8 @@
-// Modal analysis (DESIGN.md §2): small vibrations about the current configuration (a static
-// equilibrium or the initial one). Mass matrix (blocks m I, A J A^T) and exact tangent stiffness
-// K = -d wrench / d (dc, dtheta); the lowest modes of the generalized symmetric eigenproblem
-// K x = w^2 M x come from the shifted inverse problem (K + mu M)^-1 M x = x / (w^2 + mu), solved
-// densely (Eigen) for small scenes and by Lanczos (Spectra) for large ones.
+// Modal analysis (docs/model.md "Analyses"): small vibrations about the current configuration (a
+// static equilibrium or the initial one). Mass matrix (blocks m I, A J A^T) and exact tangent
+// stiffness K = -d wrench / d (dc, dtheta); the lowest modes of the generalized symmetric
+// eigenproblem K x = w^2 M x come from the shifted inverse problem (K + mu M)^-1 M x = x / (w^2 +
+// mu), solved densely (Eigen) for small scenes and by Lanczos (Spectra) for large ones.
 //
 // The shift mu is 0 when every free body is held by beams to a fixed body (K is then positive
 // definite unless the loads buckle it), so the lowest eigenvalues are resolved to their own

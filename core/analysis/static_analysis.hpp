@@ -1,8 +1,8 @@
-// Static analysis (DESIGN.md §2): equilibrium of all free bodies under gravity and the loads at a
-// given time, geometrically nonlinear. Newton's method on 6 unknowns per free body (centre
-// displacement and rotation increment) with the exact tangent by automatic differentiation
-// (factored by KLU with the topology's shared symbolic analysis), a backtracking line search, and
-// automatic load stepping when a full step fails.
+// Static analysis (docs/model.md "Analyses"): equilibrium of all free bodies under gravity and the
+// loads at a given time, geometrically nonlinear. Newton's method on 6 unknowns per free body
+// (centre displacement and rotation increment) with the exact tangent by automatic differentiation
+// (factored by KLU with the topology's shared symbolic analysis), full Newton steps (halved only
+// when they make the forces non-finite), and automatic load stepping when a full load step fails.
 //
 // What a converged result promises (result.ok):
 //  - balance: the residual is below tolerance x the load scale, or, where rounding keeps it

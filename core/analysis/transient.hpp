@@ -1,7 +1,7 @@
-// Transient analysis (DESIGN.md §2): integrates the equations of motion of the free bodies from
-// the Model's initial state with CVODE (BDF, Newton iterations, exact Jacobian by automatic
-// differentiation), keeping |q| = 1 by CVODE's projection, and reports a sample at every output
-// step.
+// Transient analysis (docs/model.md "Analyses"): integrates the equations of motion of the free
+// bodies from the Model's initial state with CVODE (BDF, Newton iterations, exact Jacobian by
+// automatic differentiation), keeping |q| = 1 by CVODE's projection, and reports a sample at every
+// output step.
 #pragma once
 
 #include <functional>

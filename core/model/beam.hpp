@@ -1,4 +1,4 @@
-// The beam kernel (DESIGN.md §1, paper section 1): wrenches of a massless elastic beam on its two
+// The beam kernel (docs/model.md "Beams"): wrenches of a massless elastic beam on its two
 // bodies, in either force formulation, with stiffness-proportional damping.
 #pragma once
 

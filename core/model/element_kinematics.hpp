@@ -1,5 +1,5 @@
-// Kinematics shared by beams and rails (DESIGN.md §1, paper steps 1-4): the element frame carried
-// by each end, the deformation measured in the left-end frame, its rate, and the map from a
+// Kinematics shared by beams and rails (docs/model.md "Beams", steps 1-4): the element frame
+// carried by each end, the deformation measured in the left-end frame, its rate, and the map from a
 // deformation gradient to the wrenches on the two bodies.
 //
 // Deformation coordinates: xi = E1^T (p2 - p1) (position of point 2 in the left-end frame) and

@@ -1,4 +1,4 @@
-// The rail kernel (DESIGN.md §1, paper section 2): a beam fixed to body 1 along its local x on
+// The rail kernel (docs/model.md "Rails"): a beam fixed to body 1 along its local x on
 // which body 2 slides. Its deformable length l is the current axial coordinate of point 2 in the
 // left-end frame, floored in magnitude at min_length; it has no axial stiffness, and a cylindrical
 // rail has no torsional stiffness either.

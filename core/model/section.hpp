@@ -1,5 +1,6 @@
-// Cross-section properties of the standard shapes (SPEC.md "sections"): area S, torsion constant
-// Ix, second moments Iy, Iz and section moduli Wy, Wz. Width runs along local y, height along z.
+// Cross-section properties of the standard shapes (docs/study_files.md "sections"): area S, torsion
+// constant Ix, second moments Iy, Iz and section moduli Wy, Wz. Width runs along local y, height
+// along z.
 #pragma once
 
 #include "core/model/model.hpp"

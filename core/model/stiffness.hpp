@@ -1,4 +1,4 @@
-// The local stiffness blocks K1 and K2 of DESIGN.md §1 (the paper's, with its four sign errors in
+// The local stiffness blocks K1 and K2 of docs/model.md (the paper's, with its four sign errors in
 // K2 corrected), applied without forming 6 x 6 matrices.
 //
 // The length enters as a signed value l (rails: the carriage may pass behind point 1). A beam of

@@ -1,6 +1,6 @@
-// Scene loading: the "scene" object of a study (SPEC.md) -> Model, with strict validation. Every
-// problem is reported to Diagnostics with its file and JSON pointer; a Model is returned only when
-// there are none.
+// Scene loading: the "scene" object of a study (docs/study_files.md) -> Model, with strict
+// validation. Every problem is reported to Diagnostics with its file and JSON pointer; a Model is
+// returned only when there are none.
 #pragma once
 
 #include <optional>

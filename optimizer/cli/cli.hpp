@@ -1,4 +1,4 @@
-// The beamrail command line (SPEC.md "Command line").
+// The beamrail command line (docs/study_files.md "Command line").
 #pragma once
 
 #include <string>

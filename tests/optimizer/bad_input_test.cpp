@@ -1,6 +1,7 @@
 // Bad input through the real command line: every broken study exits with status 2 and lists each
-// problem as one line "file:/json/pointer: message" on stderr (SPEC.md "Command line"), without a
-// crash, a hang or an uncaught exception. Each test starts from a valid study and breaks one thing.
+// problem as one line "file:/json/pointer: message" on stderr (docs/study_files.md "Command line"),
+// without a crash, a hang or an uncaught exception. Each test starts from a valid study and breaks
+// one thing.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>

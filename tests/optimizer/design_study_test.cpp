@@ -1,8 +1,8 @@
-// Design studies through the real command line (SPEC.md "study", "Outputs"): the optimizer finds a
-// closed-form optimum, sweep rows equal single runs of the same designs, tables do not depend on
-// the number of threads, interrupted runs (truncated tables, SIGKILL) resume to the uninterrupted
-// result, designs that break the scene or the analysis become rows with a status, and design
-// variables that address no number are bad input.
+// Design studies through the real command line (docs/study_files.md "study", "Outputs"): the
+// optimizer finds a closed-form optimum, sweep rows equal single runs of the same designs, tables
+// do not depend on the number of threads, interrupted runs (truncated tables, SIGKILL) resume to
+// the uninterrupted result, designs that break the scene or the analysis become rows with a status,
+// and design variables that address no number are bad input.
 #include <gtest/gtest.h>
 #include <stdlib.h>
 

@@ -98,7 +98,7 @@ TEST(Conservation, TumblingPairConservesEnergyAndMomenta) {
       EXPECT_LT(energy_drift, 1e-7);
       EXPECT_LT(h_drift, 1e-8);
     } else {
-      // DESIGN.md §1: the paper's end wrenches are not conservative beyond first order (the
+      // docs/model.md: the paper's end wrenches are not conservative beyond first order (the
       // prototype lost 5 % in 1 s); it must show here, far above the integration error.
       EXPECT_GT(energy_drift, 1e-4);
     }

@@ -1,6 +1,6 @@
-// Segmented beams converge to continuum solutions at second order (DESIGN.md §4): Euler-Bernoulli
-// frequencies (clamped-free and clamped-clamped) and the Euler elastica. Each test prints the
-// errors and the observed orders log2(e_{N/2} / e_N).
+// Segmented beams converge to continuum solutions at second order (docs/model.md "Validation"):
+// Euler-Bernoulli frequencies (clamped-free and clamped-clamped) and the Euler elastica. Each test
+// prints the errors and the observed orders log2(e_{N/2} / e_N).
 #include <gtest/gtest.h>
 
 #include <cmath>

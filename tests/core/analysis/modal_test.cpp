@@ -1,4 +1,5 @@
-// Modal analysis against closed forms (DESIGN.md §4), rigid-body modes, and dense vs Spectra.
+// Modal analysis against closed forms (docs/model.md "Validation"), rigid-body modes, and dense vs
+// Spectra.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>

@@ -1,5 +1,6 @@
 // A carriage on a prismatic or cylindrical rail: it slides freely along the rail, and a lateral
-// load at carriage distance a deflects it by P a^3 / (3 E I) whatever a is (DESIGN.md §4).
+// load at carriage distance a deflects it by P a^3 / (3 E I) whatever a is (docs/model.md
+// "Validation").
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,7 +1,8 @@
 // Rails in static analysis: a carriage on one prismatic rail against the cantilever formula
-// P a^3 / (3 E I) (DESIGN.md §4), the energy formulation's configurational force that leaves an
-// unrestrained carriage without equilibrium, and a carriage on two parallel rails held by a drive
-// rod, whose reactions in each rail match the hand solution of the statically indeterminate system.
+// P a^3 / (3 E I) (docs/model.md "Validation"), the energy formulation's configurational force that
+// leaves an unrestrained carriage without equilibrium, and a carriage on two parallel rails held by
+// a drive rod, whose reactions in each rail match the hand solution of the statically indeterminate
+// system.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -215,7 +216,7 @@ struct HandSolution {
 // and its twist psi about x (the load in -y excites no other motion, to first order). Member i
 // attaches at R_i = (0, 0, z_i) from the centre, so its tip moves by v + (theta x R_i)_y =
 // v - psi z_i =: v_i, turns by theta_z about z and twists by psi about x. Its end-2 forces (acting
-// ON the member, DESIGN.md K2 rows 2, 6, 4) are
+// ON the member, docs/model.md K2 rows 2, 6, 4) are
 //   F_i  = 12 EI / a^3 v_i - 6 EI / a^2 theta_z,
 //   Mz_i = -6 EI / a^2 v_i + 4 EI / a   theta_z,
 //   Mx_i = GJ / a psi.

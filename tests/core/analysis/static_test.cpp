@@ -1,4 +1,5 @@
-// Static analysis against the closed forms of DESIGN.md §4 (linear range, 1e-9 relative).
+// Static analysis against the closed forms of docs/model.md "Validation" (linear range, 1e-9
+// relative).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Transient analysis against closed forms and conservation laws (DESIGN.md §4).
+// Transient analysis against closed forms and conservation laws (docs/model.md "Validation").
 #include "core/analysis/transient.hpp"
 
 #include <gtest/gtest.h>

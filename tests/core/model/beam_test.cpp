@@ -1,4 +1,4 @@
-// Property tests of the beam kernel (DESIGN.md §1) on random configurations, both formulations.
+// Property tests of the beam kernel (docs/model.md) on random configurations, both formulations.
 #include "core/model/beam.hpp"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
-// Property tests of the rail kernel (DESIGN.md §1, "Rail guides") on random configurations:
+// Property tests of the rail kernel (docs/model.md "Rails") on random configurations:
 // prismatic and cylindrical rails, both force formulations, plus the closed forms of the
-// validation ladder (DESIGN.md §4: carriage at distance a, lateral load P, deflection P a^3/(3
-// EI)).
+// validation ladder (docs/model.md "Validation": carriage at distance a, lateral load P, deflection
+// P a^3/(3 EI)).
 #include "core/model/rail.hpp"
 
 #include <gtest/gtest.h>
@@ -626,8 +626,8 @@ TEST(Rail, CarriageBehindPointOneIsTheMirrorImage) {
 // to distance a from an initial 0.5 m, the rail must push back with -P and no moment about the
 // carriage point: the carriage is in equilibrium under the load P alone, and since the 2 x 2
 // bending block of K2 is invertible, (u, theta) is the only such equilibrium. So the carriage
-// deflects P a^3 / (3 EI) for every a (DESIGN.md §4). Both bending planes, EIy != EIz.
-// Along the rail, the energy formulation's configurational force -dU/dl at fixed (u, theta) is
+// deflects P a^3 / (3 EI) for every a (docs/model.md "Validation"). Both bending planes, EIy !=
+// EIz. Along the rail, the energy formulation's configurational force -dU/dl at fixed (u, theta) is
 // M^2 / (2 EI) + V theta (M, V: end moment and shear), here P theta = P^2 a^2 / (2 EI): exactly the
 // axial component of a reaction P normal to the deformed rail at the carriage, as frictionless
 // sliding requires (with the end moment M = 0 there is no Eshelby-like M^2 / (2 EI) term). The

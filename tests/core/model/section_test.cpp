@@ -56,7 +56,7 @@ TEST(Section, RectangleTorsionConstantMatchesTheClassicalTable) {
     const double a = row.ratio * b;
     const double beta = rectangle_torsion_constant(a, b) / (a * b * b * b);
     EXPECT_LE(std::abs(beta - row.table), 5e-5) << "a/b = " << row.ratio << ": beta = " << beta;
-    // A converged series: 9 digits (DESIGN.md §4's standard for linear cases).
+    // A converged series: 9 digits (docs/model.md "Validation"'s standard for linear cases).
     EXPECT_LT(relative(beta, row.series), 1e-9) << "a/b = " << row.ratio;
     worst_table = std::max(worst_table, std::abs(beta - row.table));
     worst_series = std::max(worst_series, relative(beta, row.series));

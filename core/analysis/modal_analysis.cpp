@@ -15,6 +15,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/analysis/deadline.hpp"
 #include "core/analysis/element_deformation.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
@@ -24,17 +25,6 @@ namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Clock = std::chrono::steady_clock;
-
-// Thrown out of an eigensolver's iterations when the analysis's budget is spent.
-struct BudgetSpent {};
-
-struct Budget {
-  bool active = false;
-  Clock::time_point end;
-  void check() const {
-    if (active && Clock::now() > end) throw BudgetSpent{};
-  }
-};
 
 // The shift mu of the inverse problem. 0 when the elastic stiffness is positive definite: the
 // inverse problem then resolves the lowest eigenvalue to its own relative accuracy however stiff
@@ -53,7 +43,7 @@ double choose_shift(const Model& model, const SparseMatrix& k, const SparseMatri
 class ShiftSolve {
  public:
   using Scalar = double;
-  ShiftSolve(const SparseMatrix& k, const SparseMatrix& m, const Budget& budget)
+  ShiftSolve(const SparseMatrix& k, const SparseMatrix& m, const Deadline& budget)
       : k_(k), m_(m), budget_(budget) {}
   Eigen::Index rows() const { return k_.rows(); }
   Eigen::Index cols() const { return k_.cols(); }
@@ -74,7 +64,7 @@ class ShiftSolve {
  private:
   const SparseMatrix& k_;
   const SparseMatrix& m_;
-  const Budget& budget_;
+  const Deadline& budget_;
   Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
 };
 
@@ -90,7 +80,7 @@ bool solve_dense(const SparseMatrix& k, const SparseMatrix& m, double shift, Eig
 
 // The `count` eigenpairs nearest the shift -mu by Lanczos; false when it did not converge.
 bool solve_lanczos(const SparseMatrix& k, const SparseMatrix& m, double shift, Eigen::Index count,
-                   const Budget& budget, Eigenpairs& out) {
+                   const Deadline& budget, Eigenpairs& out) {
   const Eigen::Index n = k.rows();
   const Eigen::Index nev = std::min<Eigen::Index>(n - 1, count);
   const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
@@ -121,7 +111,7 @@ class NonsymmetricShiftSolve {
  public:
   using Scalar = double;
   NonsymmetricShiftSolve(const SparseMatrix& k, const SparseMatrix& m, const SparseMatrix& l,
-                         const Budget& budget)
+                         const Deadline& budget)
       : k_(k), m_(m), l_(l), budget_(budget) {}
   Eigen::Index rows() const { return k_.rows(); }
   Eigen::Index cols() const { return k_.cols(); }
@@ -144,14 +134,14 @@ class NonsymmetricShiftSolve {
   const SparseMatrix& k_;
   const SparseMatrix& m_;
   const SparseMatrix& l_;
-  const Budget& budget_;
+  const Deadline& budget_;
   Eigen::SparseLU<SparseMatrix> lu_;
 };
 
 // The `count` eigenvalues of the non-symmetric K x = lambda M x nearest -shift by Arnoldi with
 // shift-invert (Spectra), M = L L^T; eigenvectors L^T x when `vectors` is given.
 bool arnoldi_nonsymmetric(const SparseMatrix& k, const SparseMatrix& m, const SparseMatrix& l,
-                          double shift, Eigen::Index count, const Budget& budget,
+                          double shift, Eigen::Index count, const Deadline& budget,
                           Eigen::VectorXcd& values, Eigen::MatrixXcd* vectors) {
   const Eigen::Index n = k.rows();
   const Eigen::Index nev = std::min<Eigen::Index>(n - 2, count);
@@ -173,7 +163,7 @@ bool arnoldi_nonsymmetric(const SparseMatrix& k, const SparseMatrix& m, const Sp
 // grows) are counted in *complex_pairs (one per conjugate pair) with the largest
 // |Im w^2| / |w^2| in *growth. False when the eigensolver did not converge.
 bool solve_nonsymmetric(const SparseMatrix& k, const SparseMatrix& m, double shift,
-                        Eigen::Index count, bool dense, const Budget& budget, Eigenpairs& out,
+                        Eigen::Index count, bool dense, const Deadline& budget, Eigenpairs& out,
                         int* complex_pairs, double* growth) {
   const Eigen::Index n = k.rows();
   const Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> mf(m);
@@ -331,7 +321,7 @@ bool nonsymmetric_eigenvalues_near(const Eigen::SparseMatrix<double>& k,
   if (mf.info() != Eigen::Success) return false;
   const SparseMatrix l = mf.matrixL();
   try {
-    return arnoldi_nonsymmetric(k, m, l, shift, count, Budget{}, values, nullptr);
+    return arnoldi_nonsymmetric(k, m, l, shift, count, Deadline{}, values, nullptr);
   } catch (const std::exception&) {
     return false;
   }
@@ -347,12 +337,7 @@ const Mode* elastic_mode(const ModalResult& result, int k) {
 ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& data) {
   const auto start = Clock::now();
   ModalResult result;
-  Budget budget;
-  if (options.max_seconds > 0.0) {
-    budget.active = true;
-    budget.end = start + std::chrono::duration_cast<Clock::duration>(
-                             std::chrono::duration<double>(options.max_seconds));
-  }
+  const Deadline budget(start, options.max_seconds);
   try {
     compute_wrenches(model, data, options.time, options.load_factor);
     compute_tangent(model, data, options.time, false, options.load_factor);
@@ -475,7 +460,7 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
           "the tangent stiffness is not symmetric (relative asymmetry " +
           std::to_string(result.asymmetry) +
           ") although no torque loads the scene: the configuration is not an equilibrium");
-  } catch (const BudgetSpent&) {
+  } catch (const DeadlinePassed&) {
     result.ok = false;
     result.timed_out = true;
     result.modes.clear();

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/analysis/deadline.hpp"
 #include "core/analysis/deformation_check.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/model/element_kinematics.hpp"
@@ -24,14 +25,6 @@ std::string format(const char* pattern, double a, double b = 0.0) {
   char text[400];
   std::snprintf(text, sizeof text, pattern, a, b);
   return text;
-}
-
-// Largest element length, the length that turns moments into forces in the residual norm.
-double characteristic_length(const Model& model) {
-  double l = 0.0;
-  for (const Beam& e : model.beams) l = std::max(l, e.ends.length);
-  for (const Rail& e : model.rails) l = std::max(l, e.ends.length);
-  return l > 0.0 ? l : 1.0;
 }
 
 // The load scale: the largest applied force (moments / length) or weight, at full load.
@@ -215,14 +208,8 @@ class TangentSolver {
   bool use_dense_ = false;
 };
 
-struct Budget {
-  bool active = false;
-  Clock::time_point end;
-  bool spent() const { return active && Clock::now() > end; }
-};
-
 struct Newton {
-  Newton(const Model& m, Data& d, double time, double len, int max_it, const Budget& b,
+  Newton(const Model& m, Data& d, double time, double len, int max_it, const Deadline& b,
          std::shared_ptr<const SparseStructure> structure)
       : model(m),
         data(d),
@@ -235,7 +222,7 @@ struct Newton {
   Data& data;
   double t, length;
   int max_iterations;
-  const Budget& budget;
+  const Deadline& budget;
   TangentSolver solver;
   const bool held = held_by_beams(model);  // every free body held by beams to a fixed body
   int iterations = 0;
@@ -327,7 +314,7 @@ struct Newton {
         residual = r;
         return true;
       }
-      if (budget.spent())
+      if (budget.passed())
         return fail("the static analysis did not finish within its time budget", true);
       compute_tangent(model, data, t, false, factor);
       const Eigen::VectorXd w = wrench_vector(model, data);
@@ -498,12 +485,7 @@ Stability stability(const Model& model, Data& data, double t) {
 StaticResult solve_static(const Model& model, const StaticOptions& options, Data& data) {
   const auto start = Clock::now();
   StaticResult result;
-  Budget budget;
-  if (options.max_seconds > 0.0) {
-    budget.active = true;
-    budget.end = start + std::chrono::duration_cast<Clock::duration>(
-                             std::chrono::duration<double>(options.max_seconds));
-  }
+  const Deadline budget(start, options.max_seconds);
   try {
     reset_to_initial(model, data);
     const double length = characteristic_length(model);
@@ -549,7 +531,7 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
             !edge.empty())
           result.message = format("at load factor %.6g, ", done) + edge +
                            "; beyond it the Newton iterations failed: " + result.message;
-        result.timed_out = budget.spent();
+        result.timed_out = budget.passed();
         break;
       }
     }

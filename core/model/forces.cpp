@@ -5,9 +5,7 @@
 #include "core/model/rail.hpp"
 
 namespace beamrail {
-namespace {
-
-void add_loads(const Model& model, Data& data, double t, double load_factor) {
+void add_load_wrenches(const Model& model, Data& data, double t, double load_factor) {
   for (int i : model.free_bodies)
     data.wrench[i].head<3>() += load_factor * model.bodies[i].mass * model.gravity;
   for (const Load& load : model.loads) {
@@ -23,6 +21,19 @@ void add_loads(const Model& model, Data& data, double t, double load_factor) {
   }
 }
 
+void add_load_stiffness(const Model& model, Data& data, double t, double load_factor) {
+  // Loads at body points: the moment lever turns with the body, d(R x F)/dtheta = [F]x [R]x.
+  for (const Load& load : model.loads) {
+    const int k = model.bodies[load.body].free_index;
+    if (k < 0 || load.kind != LoadKind::kForce) continue;
+    const Vec3 value = load_factor * load.time(t) * load.value;
+    const Vec3 lever = data.pose[load.body].A * load.offset;
+    data.stiffness[k].block<3, 3>(3, 3) += skew<double>(value) * skew<double>(lever);
+  }
+}
+
+namespace {
+
 // Scatters an element's 12 x 12 derivative into the four pattern blocks of its ends.
 void scatter(const std::array<int, 4>& blocks, const Mat12& j, std::vector<Mat6>& out) {
   for (int a = 0; a < 2; ++a)
@@ -36,7 +47,7 @@ void scatter(const std::array<int, 4>& blocks, const Mat12& j, std::vector<Mat6>
 
 void compute_wrenches(const Model& model, Data& data, double t, double load_factor) {
   for (Vec6& w : data.wrench) w.setZero();
-  add_loads(model, data, t, load_factor);
+  add_load_wrenches(model, data, t, load_factor);
   double energy = 0.0;
   bool out = false;
   for (const Beam& e : model.beams) {
@@ -64,14 +75,7 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
   if (with_velocity)
     for (Mat6& c : data.damping) c.setZero();
 
-  // Loads at body points: the moment lever turns with the body, d(R x F)/dtheta = [F]x [R]x.
-  for (const Load& load : model.loads) {
-    const int k = model.bodies[load.body].free_index;
-    if (k < 0 || load.kind != LoadKind::kForce) continue;
-    const Vec3 value = load_factor * load.time(t) * load.value;
-    const Vec3 lever = data.pose[load.body].A * load.offset;
-    data.stiffness[k].block<3, 3>(3, 3) += skew<double>(value) * skew<double>(lever);
-  }
+  add_load_stiffness(model, data, t, load_factor);
 
   // The closed-form Jacobian for undamped elements, and for every element when velocities do not
   // matter (static and modal analyses linearize at rest, where damping forces vanish); forward

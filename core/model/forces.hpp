@@ -20,6 +20,15 @@ void compute_wrenches(const Model& model, Data& data, double t, double load_fact
 void compute_tangent(const Model& model, Data& data, double t, bool with_velocity,
                      double load_factor = 1.0);
 
+// Adds gravity and the loads at time t, scaled by load_factor, to data.wrench (part of
+// compute_wrenches).
+void add_load_wrenches(const Model& model, Data& data, double t, double load_factor);
+
+// Adds the loads' part of the tangent, scaled by load_factor, to data.stiffness (part of
+// compute_tangent): a force at a body point turns its lever with the body, d(R x F)/dtheta =
+// [F]x [R]x. Gravity acts at the centres and adds none.
+void add_load_stiffness(const Model& model, Data& data, double t, double load_factor);
+
 // Kinetic energy of all free bodies [J].
 double kinetic_energy(const Model& model, const Data& data);
 

@@ -1,5 +1,6 @@
 #include "core/model/model.hpp"
 
+#include <algorithm>
 #include <map>
 #include <utility>
 
@@ -47,6 +48,13 @@ void Model::finalize() {
   pattern.transposed.resize(pattern.blocks.size());
   for (size_t b = 0; b < pattern.blocks.size(); ++b)
     pattern.transposed[b] = index.at({pattern.blocks[b].col, pattern.blocks[b].row});
+}
+
+double characteristic_length(const Model& model) {
+  double l = 0.0;
+  for (const Beam& e : model.beams) l = std::max(l, e.ends.length);
+  for (const Rail& e : model.rails) l = std::max(l, e.ends.length);
+  return l > 0.0 ? l : 1.0;
 }
 
 bool held_by_beams(const Model& model) {

@@ -29,7 +29,7 @@ struct Body {
   int free_index = -1;         // position among the free bodies, -1 if fixed
 };
 
-// Where an element attaches to its two bodies; computed once at set-up (DESIGN.md §1).
+// Where an element attaches to its two bodies; computed once at set-up (docs/model.md).
 struct ElementEnds {
   int body1 = 0, body2 = 0;           // body indices
   Vec3 r1 = Vec3::Zero();             // point 1 in body-1 axes, from its centre of mass [m]
@@ -40,7 +40,7 @@ struct ElementEnds {
   double length = 0.0;                // |p2 - p1| in the initial configuration [m]
 };
 
-// Which of the two force laws of DESIGN.md §1 an element uses.
+// Which of the two force laws of docs/model.md an element uses.
 enum class Formulation { kEnergy, kPaper };
 
 // Cross-section properties kept for stress recovery and mass.
@@ -93,6 +93,7 @@ struct Load {
   Vec3 offset = Vec3::Zero();  // force: point of application in body axes, from the centre [m]
   Vec3 value = Vec3::Zero();   // global axes [N] or [N m], scaled by time(t)
   TimeFunction time;
+  std::string load_case;  // the load case it belongs to; empty: none (applied by every analysis)
 };
 
 // Couplings between free bodies: the non-zero 6 x 6 blocks of tangent matrices, computed once.
@@ -113,7 +114,8 @@ struct Model {
   std::vector<Beam> beams;
   std::vector<Rail> rails;
   std::vector<Load> loads;
-  Vec3 gravity = Vec3::Zero();  // [m/s^2]
+  Vec3 gravity = Vec3::Zero();          // [m/s^2]
+  std::vector<std::string> load_cases;  // the names loads give as their case, in scene order
 
   std::vector<int> free_bodies;  // body index of each free body, in state order
   int n_states = 0;              // 13 per free body: c(3), q(4), v(3), w(3)
@@ -126,6 +128,36 @@ struct Model {
   // the scene loader after the element arrays are final.
   void finalize();
 };
+
+// The model with only the loads for which keep(load) is true, and with gravity or without. Bodies,
+// elements and the pattern are those of `model` (an analysis of one load case sees the same
+// structure).
+template <class Keep>
+Model with_loads(const Model& model, Keep&& keep, bool gravity) {
+  Model out;
+  out.bodies = model.bodies;
+  out.beams = model.beams;
+  out.rails = model.rails;
+  for (const Load& load : model.loads)
+    if (keep(load)) out.loads.push_back(load);
+  out.gravity = gravity ? model.gravity : Vec3::Zero();
+  out.load_cases = model.load_cases;
+  out.free_bodies = model.free_bodies;
+  out.n_states = model.n_states;
+  out.n_dofs = model.n_dofs;
+  out.pattern = model.pattern;
+  return out;
+}
+
+// The loads an analysis of `load_case` applies: the loads without a case and those of the case
+// ("": the loads without a case only); gravity always.
+inline bool applies_in_case(const Load& load, const std::string& load_case) {
+  return load.load_case.empty() || load.load_case == load_case;
+}
+
+// The largest element length [m] (1 without elements): the length that turns rotations into
+// displacements and moments into forces where the analyses compare them.
+double characteristic_length(const Model& model);
 
 // True when every free body is joined through beams (which resist all six relative motions) to a
 // fixed body: the elastic stiffness is then positive definite (no rigid-body or mechanism mode).

@@ -296,6 +296,7 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
   }
   if (diag.size() > errors_before) return std::nullopt;
 
+  model.load_cases = specs.load_cases;
   model.finalize();
   if (model.n_free() == 0) {
     diag.error(

@@ -1,5 +1,6 @@
 // Readers of the scene's materials, sections, bodies, beams, rails and loads.
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -422,11 +423,14 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     if (!r.is_object()) return;
     Load load;
     const auto type = r.choice("type", true, {"force", "torque"});
-    if (!type) r.allow({"point"});
+    if (!type) r.allow({"point", "case"});
     const auto body = body_ref(r, "body", specs);
     std::optional<Vec3> point;
     if (type && *type == "force") point = r.vec3("point", false);
     const auto value = r.vec3("value", true);
+    const auto load_case = r.string("case", false);
+    if (load_case && load_case->empty())
+      r.error("case", "must not be empty (omit it for a load of every analysis)");
     std::optional<TimeFunction> time = TimeFunction{};
     if (const Json* t = r.member("time", false)) time = read_time_function(*t, at / "time", diag);
     if (body && specs.bodies[*body].fixed) {
@@ -434,7 +438,13 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
               "body \"" + specs.bodies[*body].name + "\" is fixed: a load on it does nothing");
       return;
     }
-    if (!type || !body || !value || !time) return;
+    if (!type || !body || !value || !time || (load_case && load_case->empty())) return;
+    if (load_case) {
+      load.load_case = *load_case;
+      if (std::find(specs.load_cases.begin(), specs.load_cases.end(), *load_case) ==
+          specs.load_cases.end())
+        specs.load_cases.push_back(*load_case);
+    }
     load.kind = *type == "force" ? LoadKind::kForce : LoadKind::kTorque;
     load.body = *body;
     load.value = *value;

@@ -69,7 +69,8 @@ struct SceneSpecs {
   std::vector<ElementSpec> elements;
   long n_segments = 0;  // of the elements read so far (kMaxSegments + 1 once over the limit)
   std::vector<Load> loads;
-  std::vector<Vec3> load_points;  // global application point of each load
+  std::vector<Vec3> load_points;        // global application point of each load
+  std::vector<std::string> load_cases;  // the case names loads give, in order of first use
 };
 
 // More segments than this in one scene, all beams together, would only exhaust memory and time

@@ -1,0 +1,76 @@
+// Linear buckling analysis (docs/model.md "Analyses", "Linear buckling"): the load factors lambda
+// at which a structure, held in a reference state under loads that stay constant, loses its
+// stiffness when further loads grow as lambda times their value:
+//
+//   (K0 + lambda K1) phi = 0,
+//
+// K0 the tangent stiffness (K = -d wrench / d (dc, dtheta)) at the reference state, K1 its
+// derivative along the linear response u1 = K0^-1 P1 to the scaled loads P1: the stress
+// (geometric) stiffness of the forces u1 puts in the elements, the change of the element stiffness
+// with u1's geometry, and the load stiffness of forces at body points (their levers turn with the
+// bodies). A factor lambda > 1 means the scaled loads can grow lambda-fold before the structure
+// buckles, to first order (prebuckling rotations small).
+//
+// K1's element part is the central difference of the exact element tangent along u1 at two step
+// sizes, extrapolated (Richardson): the factors it gives change by 1e-10 between steps ten times
+// apart (measured; buckling_analysis.cpp). The load part is exact.
+//
+// The reference state's stiffness must be positive definite: every free body held (a free body or
+// a carriage free along its rails has no stiffness against motion there, and a buckling factor
+// along such a direction means nothing). Loads that are not conservative (torques of fixed
+// direction make the tangent non-symmetric) are refused.
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/analysis/modal_analysis.hpp"
+#include "core/model/data.hpp"
+#include "core/model/model.hpp"
+
+namespace beamrail {
+
+struct BucklingOptions {
+  int modes = 1;                                    // lowest positive load factors wanted
+  EigenSolverKind solver = EigenSolverKind::kAuto;  // kShiftInvert: Lanczos
+  int dense_limit = 60;  // kAuto: dense up to this many degrees of freedom
+  double time = std::numeric_limits<double>::infinity();  // loads' time
+  double max_seconds = 0.0;  // wall-clock budget [s]; 0: none (result.timed_out when spent)
+};
+
+struct BucklingMode {
+  double factor = 0.0;  // lambda [-]
+  // The buckling shape (dim n_dofs): the largest of |translation| and |rotation| x the
+  // characteristic length is 1, and the largest entry positive.
+  Eigen::VectorXd shape;
+};
+
+struct BucklingResult {
+  bool ok = false;
+  bool timed_out = false;
+  std::string message;
+  std::string solver;               // "dense" or "lanczos"
+  std::vector<BucklingMode> modes;  // the lowest positive factors, ascending
+  // Positive factors found in all: fewer than asked for when the scaled loads compress too little
+  // of the structure (a structure in tension does not buckle); the missing factors are infinite.
+  int positive_factors = 0;
+  double asymmetry = 0.0;  // of K1's element part, |K1 - K1^T| / |K1| (rounding: ~1e-10)
+  double step = 0.0;       // the larger difference step along u1, as the largest rotation or
+                           // strain it causes [rad or -]
+  double wall_seconds = 0.0;
+  std::vector<std::string> warnings;
+};
+
+// Solves the buckling eigenproblem about the state in data.pose: `reference` is the structure
+// with the loads that stay constant (data.pose is its equilibrium under them, or its initial
+// state when it has none), `scaled` the same structure (the same bodies and elements) with the
+// loads that lambda multiplies. Never throws.
+BucklingResult solve_buckling(const Model& reference, const Model& scaled,
+                              const BucklingOptions& options, Data& data);
+
+// The k-th lowest positive factor (1-based), +infinity when the structure has fewer.
+double buckling_factor(const BucklingResult& result, int k);
+
+}  // namespace beamrail

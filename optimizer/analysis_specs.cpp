@@ -1,11 +1,12 @@
-// Reading the "analyses" entries of a study: transient, static and modal.
+// Reading the "analyses" entries of a study: transient, static, modal and buckling.
+#include <cctype>
 #include <cmath>
 
 #include "optimizer/study.hpp"
 
 namespace beamrail {
 
-const std::vector<std::string> kAnalysisTypes = {"transient", "static", "modal"};
+const std::vector<std::string> kAnalysisTypes = {"transient", "static", "modal", "buckling"};
 
 namespace {
 
@@ -69,6 +70,8 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
     read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
   a.verify = r.boolean("verify", false).value_or(false);
   a.transient.max_seconds = r.positive("max_seconds", false).value_or(0.0);
+  if (const auto initial = r.choice("initial", false, {"scene", "static"}))
+    a.initial_static = *initial == "static";
   if (!t_end) return false;
   a.transient.t_end = *t_end;
   a.transient.output_step = step.value_or(*t_end / 100.0);
@@ -90,14 +93,20 @@ bool has_harmonic_load(const Model* model) {
   return false;
 }
 
-bool read_static(ObjectReader& r, const Model* model, AnalysisSpec& a) {
-  bool ok = true;
+// The loads' time of a static or buckling analysis: "time", required when a load is harmonic.
+bool read_load_time(ObjectReader& r, const Model* model, double& time) {
   if (const auto t = r.positive("time", false, true)) {
-    a.statics.time = *t;
+    time = *t;
   } else if (has_harmonic_load(model) && !r.member("time", false)) {
     r.error("type", "the scene has harmonic loads, which have no final value: give \"time\"");
-    ok = false;
+    return false;
   }
+  return true;
+}
+
+bool read_static(ObjectReader& r, const Model* model, AnalysisSpec& a) {
+  bool ok = read_load_time(r, model, a.statics.time);
+  a.statics.max_seconds = r.positive("max_seconds", false).value_or(0.0);
   if (const Json* steps = r.member("load_steps", false)) {
     if (steps->is_string()) {
       if (steps->get<std::string>() != "auto") {
@@ -129,7 +138,9 @@ bool read_modal(ObjectReader& r, const Model* model, AnalysisSpec& a) {
     }
     a.modal.modes = static_cast<int>(*n);
   }
-  const bool loaded = model && (!model->loads.empty() || model->gravity.norm() > 0.0);
+  bool loaded = model && model->gravity.norm() > 0.0;
+  if (model)
+    for (const Load& load : model->loads) loaded = loaded || applies_in_case(load, a.load_case);
   const auto about = r.choice("about", false, {"static", "initial"});
   a.about_static = about ? *about == "static" : loaded;
   if (!a.about_static) a.modal.load_factor = 0.0;
@@ -137,6 +148,34 @@ bool read_modal(ObjectReader& r, const Model* model, AnalysisSpec& a) {
     a.modal.solver = *s == "dense"          ? EigenSolverKind::kDense
                      : *s == "shift-invert" ? EigenSolverKind::kShiftInvert
                                             : EigenSolverKind::kAuto;
+  a.modal.max_seconds = r.positive("max_seconds", false).value_or(0.0);
+  return true;
+}
+
+bool read_buckling(ObjectReader& r, const Model* model, AnalysisSpec& a) {
+  bool ok = read_load_time(r, model, a.buckling.time);
+  if (const auto n = r.integer("modes", false, 1)) {
+    if (*n > 10000) {
+      r.error("modes", "at most 10000 modes");
+      ok = false;
+    } else {
+      a.buckling.modes = static_cast<int>(*n);
+    }
+  }
+  if (const auto s = r.choice("solver", false, {"auto", "dense", "lanczos"}))
+    a.buckling.solver = *s == "dense"     ? EigenSolverKind::kDense
+                        : *s == "lanczos" ? EigenSolverKind::kShiftInvert
+                                          : EigenSolverKind::kAuto;
+  a.buckling.max_seconds = r.positive("max_seconds", false).value_or(0.0);
+  return ok;
+}
+
+// An analysis name: it names tables (<name>.<table>), so it must be a plain file-name part.
+bool valid_analysis_name(const std::string& name) {
+  if (name.empty() || name.size() > 64 || name[0] == '.') return false;
+  for (char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.')
+      return false;
   return true;
 }
 
@@ -149,21 +188,40 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   AnalysisSpec a;
   a.where = where;
   const auto type = r.choice("type", true, kAnalysisTypes);
+  const auto name = r.string("name", false);
+  const auto load_case = r.string("load_case", false);
   if (!type) {
     r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "time", "load_steps",
-             "tolerance", "max_iterations", "modes", "about", "solver"});
+             "tolerance", "max_iterations", "modes", "about", "solver", "initial"});
     return std::nullopt;
   }
-  bool ok = false;
+  bool ok = true;
+  if (name && !valid_analysis_name(*name)) {
+    r.error("name",
+            "must be 1 to 64 letters, digits, '_', '-' or '.', not starting with '.' (it names "
+            "the analysis's tables)");
+    ok = false;
+  }
+  if (name) a.name = *name;
+  if (load_case) {
+    if (load_case->empty()) {
+      r.error("load_case", "must not be empty (omit it for the loads without a case)");
+      ok = false;
+    }
+    a.load_case = *load_case;
+  }
   if (*type == "transient") {
     a.type = AnalysisSpec::Type::kTransient;
-    ok = read_transient(r, a);
+    ok = read_transient(r, a) && ok;
   } else if (*type == "static") {
     a.type = AnalysisSpec::Type::kStatic;
-    ok = read_static(r, model, a);
-  } else {
+    ok = read_static(r, model, a) && ok;
+  } else if (*type == "modal") {
     a.type = AnalysisSpec::Type::kModal;
-    ok = read_modal(r, model, a);
+    ok = read_modal(r, model, a) && ok;
+  } else {
+    a.type = AnalysisSpec::Type::kBuckling;
+    ok = read_buckling(r, model, a) && ok;
   }
   if (!ok) return std::nullopt;
   return a;

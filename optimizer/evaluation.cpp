@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 
 #include "core/analysis/stop_request.hpp"
 #include "optimizer/responses.hpp"
@@ -16,107 +18,137 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-const char* analysis_name(AnalysisSpec::Type type) {
-  switch (type) {
-    case AnalysisSpec::Type::kStatic:
-      return "static";
-    case AnalysisSpec::Type::kModal:
-      return "modal";
-    case AnalysisSpec::Type::kTransient:
-      break;
-  }
-  return "transient";
-}
-
 class Runner {
  public:
   Runner(const Study& study, const Model& model, const EvaluationOptions& options, Evaluation& ev,
          std::chrono::steady_clock::time_point start)
-      : study_(study),
-        model_(model),
-        options_(options),
-        ev_(ev),
-        static_data_(model),
-        start_(start) {}
+      : study_(study), model_(model), options_(options), ev_(ev), start_(start) {}
 
-  // Runs one analysis; false when it failed (the evaluation then stops).
-  bool run(const AnalysisSpec& spec) {
+  // Runs analysis `index` of the study; false when it failed (the evaluation then stops).
+  bool run(int index) {
+    const AnalysisSpec& spec = study_.analyses[index];
     AnalysisReport report;
+    report.type = type_name(spec.type);
+    report.name = spec.name;
+    report.load_case = spec.load_case;
     switch (spec.type) {
       case AnalysisSpec::Type::kStatic:
-        report = run_static(spec.statics, true);
+        run_static(index, report);
         break;
       case AnalysisSpec::Type::kModal:
-        report = run_modal(spec);
+        run_modal(index, report);
+        break;
+      case AnalysisSpec::Type::kBuckling:
+        run_buckling(index, report);
         break;
       case AnalysisSpec::Type::kTransient:
-        report = run_transient_analysis(spec);
+        run_transient_analysis(index, report);
         break;
     }
     const bool ok = report.ok;
     if (!ok) {
       ev_.status = report.interrupted ? "interrupted" : report.timed_out ? "timeout" : "failed";
-      ev_.message = report.type + " analysis: " + report.message;
+      ev_.message = report.type + " analysis";
+      if (study_.analyses.size() > 1 || spec.name != report.type)
+        ev_.message += " \"" + spec.name + "\"";
+      ev_.message += ": " + report.message;
     }
     ev_.analyses.push_back(std::move(report));
     return ok;
   }
 
  private:
-  // The static equilibrium, solved once; `listed` when the study asked for the static analysis
-  // itself (then its tables are written and its responses computed).
-  AnalysisReport run_static(const StaticOptions& options, bool listed) {
-    AnalysisReport report;
-    report.type = "static";
-    if (!static_result_) {
-      static_options_ = options;
-      static_options_.structure_cache =
-          options_.structure_cache ? options_.structure_cache : &structures_;
-      static_options_.max_seconds = budget_left(options.max_seconds);
-      static_result_ = solve_static(model_, static_options_, static_data_);
-    }
-    const StaticResult& r = *static_result_;
+  // A static equilibrium: solved once, shared by the analyses that need it.
+  struct Equilibrium {
+    StaticResult result;
+    std::unique_ptr<Data> data;
+    double time = 0.0;  // the loads' time
+  };
+
+  // The model with the loads of `load_case` (and those without a case): the study's own when
+  // every load applies.
+  const Model& case_model(const std::string& load_case) {
+    bool all = true;
+    for (const Load& load : model_.loads) all = all && applies_in_case(load, load_case);
+    if (all) return model_;
+    auto it = case_models_.find(load_case);
+    if (it == case_models_.end())
+      it = case_models_.emplace(load_case, model_for_case(model_, load_case)).first;
+    return it->second;
+  }
+
+  // The first static analysis of the study with this load case, or -1.
+  int listed_static(const std::string& load_case) const {
+    for (size_t i = 0; i < study_.analyses.size(); ++i)
+      if (study_.analyses[i].type == AnalysisSpec::Type::kStatic &&
+          study_.analyses[i].load_case == load_case)
+        return static_cast<int>(i);
+    return -1;
+  }
+
+  // The equilibrium under the loads of `load_case`: with the options of static analysis
+  // `listed` (or the defaults when -1), at the loads' time `time` (NaN: that of the options).
+  Equilibrium& equilibrium(const std::string& load_case, int listed, double time) {
+    StaticOptions options = listed >= 0 ? study_.analyses[listed].statics : StaticOptions{};
+    if (!std::isnan(time)) options.time = time;
+    const std::string key =
+        load_case + '\n' + std::to_string(listed) + '\n' + format_number(options.time);
+    auto it = equilibria_.find(key);
+    if (it != equilibria_.end()) return it->second;
+    Equilibrium& e = equilibria_[key];
+    const Model& model = case_model(load_case);
+    options.structure_cache = structure_cache();
+    options.max_seconds = budget_left(options.max_seconds);
+    e.data = std::make_unique<Data>(model);
+    e.result = solve_static(model, options, *e.data);
+    e.time = options.time;
+    return e;
+  }
+
+  void run_static(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    const Equilibrium& e = equilibrium(spec.load_case, index, kNaN);
+    const StaticResult& r = e.result;
     report.ok = r.ok;
     report.timed_out = r.timed_out;
     report.message = r.message;
     report.wall_seconds = r.wall_seconds;
     report.statics = r;
-    if (!listed || !r.ok) return report;
+    if (!r.ok) return;
     add_warnings(r.warnings);
-    static_responses(study_, model_, static_data_, ev_.responses);
-    if (!options_.output_directory.empty()) {
-      std::string error;
-      if (!write_static_tables(options_.output_directory, model_, static_data_, &error)) {
-        report.ok = false;
-        report.message = error;
-      }
+    const Model& model = case_model(spec.load_case);
+    static_responses(study_, index, model, *e.data, ev_.responses);
+    if (!writes_tables()) return;
+    const std::string prefix = table_prefix(spec);
+    std::string error;
+    if (!write_static_tables(options_.output_directory, prefix, model, *e.data, &error)) {
+      report.ok = false;
+      report.message = error;
     }
-    return report;
+    report.tables = {prefix + "static_displacements.csv", prefix + "element_forces.csv"};
   }
 
-  AnalysisReport run_modal(const AnalysisSpec& spec) {
-    AnalysisReport report;
-    report.type = "modal";
+  void run_modal(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
     report.about = spec.about_static ? "static" : "initial";
-    Data data(model_);
+    const Model& model = case_model(spec.load_case);
+    Data data(model);
     ModalOptions options = spec.modal;
     if (spec.about_static) {
-      // The static analysis listed in the study, or one with default options.
-      const int listed = find_analysis(study_, AnalysisSpec::Type::kStatic);
-      const AnalysisReport equilibrium =
-          run_static(listed >= 0 ? study_.analyses[listed].statics : StaticOptions{}, false);
-      report.statics = equilibrium.statics;
-      if (!equilibrium.ok) {
-        report.timed_out = equilibrium.timed_out;
-        report.message = "no static equilibrium to linearize about: " + equilibrium.message;
-        return report;
+      // The static analysis of this load case listed in the study, or one with default options.
+      const Equilibrium& e = equilibrium(spec.load_case, listed_static(spec.load_case), kNaN);
+      report.statics = e.result;
+      if (!e.result.ok) {
+        report.timed_out = e.result.timed_out;
+        report.message = "no static equilibrium to linearize about: " + e.result.message;
+        return;
       }
-      data.pose = static_data_.pose;
-      data.q = static_data_.q;
-      options.time = static_options_.time;
+      data.pose = e.data->pose;
+      data.q = e.data->q;
+      options.time = e.time;
     }
     options.max_seconds = budget_left(options.max_seconds);
-    const ModalResult r = solve_modal(model_, options, data);
+    const ModalResult r = solve_modal(model, options, data);
     report.ok = r.ok;
     report.timed_out = r.timed_out;
     report.shift = r.shift;
@@ -129,54 +161,123 @@ class Runner {
     report.asymmetry = r.asymmetry;
     report.nonsymmetric = r.nonsymmetric;
     add_warnings(r.warnings);
-    if (!r.ok) return report;
-    modal_responses(study_, r, ev_.responses);
-    if (!options_.output_directory.empty()) {
-      std::string error;
-      if (!write_modal_tables(options_.output_directory, model_, r, &error)) {
-        report.ok = false;
-        report.message = error;
-      }
+    if (!r.ok) return;
+    modal_responses(study_, index, r, ev_.responses);
+    if (!writes_tables()) return;
+    const std::string prefix = table_prefix(spec);
+    std::string error;
+    if (!write_modal_tables(options_.output_directory, prefix, model, r, &error)) {
+      report.ok = false;
+      report.message = error;
     }
-    return report;
+    report.tables = {prefix + "modes.csv", prefix + "mode_shapes.csv"};
   }
 
-  AnalysisReport run_transient_analysis(const AnalysisSpec& spec) {
-    AnalysisReport report;
-    report.type = "transient";
+  // Buckling of a load case: its loads scaled, the loads without a case and gravity held (the
+  // reference is their equilibrium). Without a case: the loads without a case and gravity scaled
+  // about the unloaded initial state.
+  void run_buckling(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    const std::string& c = spec.load_case;
+    const Model unloaded = with_loads(
+        model_, [](const Load&) { return false; }, false);
+    const Model scaled = with_loads(
+        model_,
+        [&](const Load& load) { return c.empty() ? load.load_case.empty() : load.load_case == c; },
+        c.empty());
     Data data(model_);
+    BucklingOptions options = spec.buckling;
+    const Model* reference = &unloaded;
+    if (!c.empty()) {
+      reference = &case_model("");
+      const Equilibrium& e = equilibrium("", listed_static(""), options.time);
+      report.statics = e.result;
+      if (!e.result.ok) {
+        report.timed_out = e.result.timed_out;
+        report.message =
+            "no static equilibrium under the constant loads (those without a case, and "
+            "gravity): " +
+            e.result.message;
+        return;
+      }
+      data.pose = e.data->pose;
+      data.q = e.data->q;
+      data.rotation = e.data->rotation;
+    }
+    options.max_seconds = budget_left(options.max_seconds);
+    const BucklingResult r = solve_buckling(*reference, scaled, options, data);
+    report.ok = r.ok;
+    report.timed_out = r.timed_out;
+    report.message = r.message;
+    report.wall_seconds = r.wall_seconds;
+    report.eigensolver = r.solver;
+    report.positive_factors = r.positive_factors;
+    for (const BucklingMode& m : r.modes) report.factors.push_back(m.factor);
+    add_warnings(r.warnings);
+    if (!r.ok) return;
+    buckling_responses(study_, index, r, ev_.responses);
+    if (!writes_tables()) return;
+    const std::string prefix = table_prefix(spec);
+    std::string error;
+    if (!write_buckling_tables(options_.output_directory, prefix, model_, r, &error)) {
+      report.ok = false;
+      report.message = error;
+    }
+    report.tables = {prefix + "buckling.csv", prefix + "buckling_shapes.csv"};
+  }
+
+  void run_transient_analysis(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    const Model& model = case_model(spec.load_case);
+    report.initial = spec.initial_static ? "static" : "scene";
+    TransientOptions options = budgeted(spec.transient);
+    if (spec.initial_static) {
+      // The equilibrium of the loads at t = 0, with the options of the case's static analysis.
+      const Equilibrium& e = equilibrium(spec.load_case, listed_static(spec.load_case), 0.0);
+      report.statics = e.result;
+      if (!e.result.ok) {
+        report.timed_out = e.result.timed_out;
+        report.message = "no static equilibrium at t = 0 to start from: " + e.result.message;
+        return;
+      }
+      options.initial_state.resize(model.n_states);
+      initial_state_at(model, *e.data, options.initial_state.data());
+      options.max_seconds = budget_left(spec.transient.max_seconds);
+    }
+    Data data(model);
     std::vector<std::pair<size_t, PointTracker>> peaks;
     for (size_t k = 0; k < study_.responses.size(); ++k)
-      if (study_.responses[k].quantity == ResponseSpec::Quantity::kPeakDisplacement) {
-        peaks.emplace_back(k, PointTracker(model_, study_.responses[k]));
+      if (study_.responses[k].quantity == ResponseSpec::Quantity::kPeakDisplacement &&
+          study_.responses[k].analysis == index) {
+        peaks.emplace_back(k, PointTracker(model, study_.responses[k]));
         ev_.responses[k] = 0.0;
       }
     TimeseriesWriter table;
     std::string table_error;
-    const bool tables = !options_.output_directory.empty();
-    if (tables && !table.open(options_.output_directory / "timeseries.csv", model_, &table_error)) {
+    const bool tables = writes_tables();
+    const std::string file = table_file(spec, "timeseries.csv");
+    if (tables && !table.open(options_.output_directory / file, model, &table_error)) {
       report.message = table_error;
-      return report;
+      return;
     }
+    if (tables) report.tables = {file};
 
-    Trajectory trajectory = trajectory_of(model_);
+    Trajectory trajectory = trajectory_of(model);
     bool first = true;
-    double scale = 0.0;
     const auto observer = [&](const TransientSample& s, const Data& d) {
       if (first) report.energy_initial = s.energy(), first = false;
       report.energy_final = s.energy();
-      scale = std::max({scale, std::abs(report.energy_initial), s.kinetic + std::abs(s.elastic)});
-      if (scale > 0.0)
-        report.energy_max_relative_change =
-            std::max(report.energy_max_relative_change,
-                     std::abs(s.energy() - report.energy_initial) / scale);
+      report.energy_max_change =
+          std::max(report.energy_max_change, std::abs(s.energy() - report.energy_initial));
       for (auto& [k, t] : peaks)
         ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
       if (tables) table.write(s, d);  // throws when the table cannot be written: the run fails
       if (spec.verify) trajectory.record(s, d);
     };
-    const TransientOptions options = budgeted(spec.transient);
-    const TransientResult result = run_transient(model_, options, data, observer);
+    const TransientResult result = run_transient(model, options, data, observer);
+    report.energy_max_relative_change =
+        report.energy_initial != 0.0 ? report.energy_max_change / std::abs(report.energy_initial)
+                                     : kNaN;
     if (tables) table.commit(&table_error);
     report.ok = result.ok;
     report.timed_out = result.timed_out;
@@ -198,14 +299,21 @@ class Runner {
     if (!result.ok)
       for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
     if (report.ok && spec.verify) {
-      report.verification = verify(options, trajectory);
+      report.verification = verify(model, options, trajectory);
       if (stop_requested() && !report.verification->ok) {
         report.ok = false;
         report.interrupted = true;
         report.message = "interrupted in the verification rerun";
       }
     }
-    return report;
+  }
+
+  bool writes_tables() const { return !options_.output_directory.empty(); }
+
+  static std::string table_prefix(const AnalysisSpec& spec) { return table_file(spec, ""); }
+
+  SparseStructureCache* structure_cache() {
+    return options_.structure_cache ? options_.structure_cache : &structures_;
   }
 
   // An analysis's own max_seconds (0: none) cut to what is left of the evaluation's budget.
@@ -219,23 +327,23 @@ class Runner {
 
   // The run's options with max_seconds cut to what is left of the evaluation's budget.
   TransientOptions budgeted(TransientOptions options) {
-    options.structure_cache = options_.structure_cache ? options_.structure_cache : &structures_;
+    options.structure_cache = structure_cache();
     options.max_seconds = budget_left(options.max_seconds);
     return options;
   }
 
   // Reruns the transient at rtol and atol divided by ten and measures how far the run was from it.
-  Verification verify(const TransientOptions& options, const Trajectory& run) {
+  Verification verify(const Model& model, const TransientOptions& options, const Trajectory& run) {
     Verification v;
     TransientOptions tight = budgeted(options);
     tight.integrator.rtol /= 10.0;
     tight.integrator.atol /= 10.0;
     v.rtol = tight.integrator.rtol;
     v.atol = tight.integrator.atol;
-    Data data(model_);
-    Trajectory reference = trajectory_of(model_);
+    Data data(model);
+    Trajectory reference = trajectory_of(model);
     const TransientResult r = run_transient(
-        model_, tight, data,
+        model, tight, data,
         [&reference](const TransientSample& s, const Data& d) { reference.record(s, d); });
     v.ok = r.ok;
     v.message = r.message;
@@ -254,9 +362,8 @@ class Runner {
   const Model& model_;
   const EvaluationOptions& options_;
   Evaluation& ev_;
-  Data static_data_;
-  StaticOptions static_options_;
-  std::optional<StaticResult> static_result_;
+  std::map<std::string, Model> case_models_;
+  std::map<std::string, Equilibrium> equilibria_;
   SparseStructureCache structures_;  // when the caller shares none
   std::chrono::steady_clock::time_point start_;
 };
@@ -272,14 +379,14 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
       if (study.responses[k].quantity == ResponseSpec::Quantity::kMass)
         ev.responses[k] = structural_mass(model);
     Runner runner(study, model, options, ev, start);
-    for (const AnalysisSpec& spec : study.analyses) {
+    for (size_t i = 0; i < study.analyses.size(); ++i) {
       if (stop_requested()) {
         ev.status = "interrupted";
-        ev.message =
-            "interrupted before the " + std::string(analysis_name(spec.type)) + " analysis";
+        ev.message = "interrupted before the " + std::string(type_name(study.analyses[i].type)) +
+                     " analysis \"" + study.analyses[i].name + "\"";
         break;
       }
-      if (!runner.run(spec)) break;
+      if (!runner.run(static_cast<int>(i))) break;
     }
   } catch (const std::exception& e) {
     ev.status = "failed";

@@ -24,7 +24,10 @@ struct Verification {
 };
 
 struct AnalysisReport {
-  std::string type;  // "transient", "static", "modal"
+  std::string type;                 // "transient", "static", "modal", "buckling"
+  std::string name;                 // the analysis's name in the study
+  std::string load_case;            // "" when it applies the loads without a case only
+  std::vector<std::string> tables;  // the files it wrote
   bool ok = false;
   bool timed_out = false;    // stopped by a max_seconds budget
   bool interrupted = false;  // stopped by a stop request (SIGINT, SIGTERM)
@@ -32,14 +35,18 @@ struct AnalysisReport {
   double wall_seconds = 0.0;
   // transient
   SolverStats stats;
-  std::string integrator;                   // method, and table if any
-  std::string linear_solver;                // dense | sparse | none
-  double t_reached = 0.0;                   // [s]
-  double energy_initial = 0.0;              // total energy at t = 0 [J]
-  double energy_final = 0.0;                // at the last sample [J]
-  double energy_max_relative_change = 0.0;  // max |E - E0| / energy scale
+  std::string integrator;          // method, and table if any
+  std::string linear_solver;       // dense | sparse | none
+  double t_reached = 0.0;          // [s]
+  std::string initial;             // "scene" or "static" (the equilibrium at t = 0)
+  double energy_initial = 0.0;     // total energy at t = 0 [J]
+  double energy_final = 0.0;       // at the last sample [J]
+  double energy_max_change = 0.0;  // max |E - E0| over the samples [J]
+  // max |E - E0| / |E0|; NaN when E0 = 0 (a run starting at rest with no energy)
+  double energy_max_relative_change = 0.0;
   std::optional<Verification> verification;
-  // static (also the equilibrium a modal analysis was linearized about)
+  // static (also the equilibrium a modal or buckling analysis is linearized about, or that a
+  // transient starts from)
   std::optional<StaticResult> statics;
   // modal
   std::string about;  // "static" or "initial"
@@ -49,6 +56,9 @@ struct AnalysisReport {
   double noise = 0.0;  // largest Mode::noise among the modes found
   double asymmetry = 0.0;
   bool nonsymmetric = false;  // the non-symmetric eigenproblem (torques of fixed direction)
+  // buckling (eigensolver above)
+  std::vector<double> factors;  // the lowest positive load factors, ascending
+  int positive_factors = 0;     // found in all (fewer than asked: the others are infinite)
 };
 
 struct Evaluation {
@@ -71,8 +81,9 @@ struct EvaluationOptions {
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed
-// order (a static equilibrium needed by a modal analysis is solved once and shared), and
-// computes the responses. Never throws.
+// order, and computes the responses. Each analysis applies the loads of its load case. A static
+// equilibrium a modal or buckling analysis needs is that of the study's static analysis of the
+// same load case (solved once and shared), or one with default options. Never throws.
 Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options);
 
 }  // namespace beamrail

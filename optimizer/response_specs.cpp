@@ -6,8 +6,8 @@
 namespace beamrail {
 
 const std::vector<std::string> kResponseQuantities = {
-    "frequency", "displacement", "rotation",     "peak_displacement",
-    "mass",      "max_stress",   "element_force"};
+    "frequency", "displacement", "rotation",      "peak_displacement",
+    "mass",      "max_stress",   "element_force", "buckling_factor"};
 
 namespace {
 
@@ -72,10 +72,56 @@ std::optional<ElementEnd> element_named(ObjectReader& r, const Model* model, int
   return std::nullopt;
 }
 
-void require(ObjectReader& r, const Study& study, const std::string& analysis,
-             const std::string& quantity) {
-  if (lacks_analysis(study.document, analysis))
-    r.error("quantity", "\"" + quantity + "\" needs a " + analysis + " analysis in \"analyses\"");
+// Whether every entry of the study's "analyses" was read (then a name not among them is unknown).
+bool all_analyses_read(const Study& study) {
+  const auto list = study.document.find("analyses");
+  return list != study.document.end() && list->is_array() && list->size() == study.analyses.size();
+}
+
+// The analysis a response reads: the one its "analysis" names, or the only one of `type`.
+// Reports a name that is unknown or of another type, a missing analysis, and an ambiguous choice.
+std::optional<int> analysis_for(ObjectReader& r, const Study& study, AnalysisSpec::Type type,
+                                const std::string& quantity) {
+  const std::string wanted = type_name(type);
+  if (const Json* given = r.member("analysis", false)) {
+    if (!given->is_string()) {
+      r.error("analysis", "expected the name of an analysis, got " + json_type_name(*given));
+      return std::nullopt;
+    }
+    const std::string name = given->get<std::string>();
+    const int k = find_analysis(study, name);
+    if (k < 0) {
+      if (!all_analyses_read(study)) return std::nullopt;  // its entry had errors
+      std::string known;
+      for (const AnalysisSpec& a : study.analyses)
+        known += (known.empty() ? "\"" : ", \"") + a.name + "\"";
+      r.error("analysis",
+              "unknown analysis \"" + name + "\" (the study's analyses: " + known + ")");
+      return std::nullopt;
+    }
+    if (study.analyses[k].type != type) {
+      r.error("analysis", "analysis \"" + name + "\" is a " + type_name(study.analyses[k].type) +
+                              " analysis; \"" + quantity + "\" needs a " + wanted + " analysis");
+      return std::nullopt;
+    }
+    return k;
+  }
+  std::vector<int> candidates;
+  for (size_t i = 0; i < study.analyses.size(); ++i)
+    if (study.analyses[i].type == type) candidates.push_back(static_cast<int>(i));
+  if (candidates.size() == 1) return candidates[0];
+  if (candidates.size() > 1) {
+    std::string names;
+    for (int k : candidates)
+      names += (names.empty() ? "\"" : ", \"") + study.analyses[k].name + "\"";
+    r.error("analysis", "the study has " + std::to_string(candidates.size()) + " " + wanted +
+                            " analyses (" + names + "): name the one \"" + quantity +
+                            "\" reads with \"analysis\"");
+    return std::nullopt;
+  }
+  if (lacks_analysis(study.document, wanted))
+    r.error("quantity", "\"" + quantity + "\" needs a " + wanted + " analysis in \"analyses\"");
+  return std::nullopt;
 }
 
 }  // namespace
@@ -90,35 +136,43 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
   s.where = where;
   const auto q = r.choice("quantity", true, kResponseQuantities);
   if (!q) {
-    r.allow(
-        {"body", "point", "direction", "axis", "mode", "element", "component", "end", "elements"});
+    r.allow({"body", "point", "direction", "axis", "mode", "element", "component", "end",
+             "elements", "analysis"});
     return std::nullopt;
   }
   if (*q == "mass") {
     s.quantity = ResponseSpec::Quantity::kMass;
     return s;
   }
-  if (*q == "frequency") {
-    s.quantity = ResponseSpec::Quantity::kFrequency;
-    require(r, study, "modal", *q);
+  if (*q == "frequency" || *q == "buckling_factor") {
+    const bool frequency = *q == "frequency";
+    s.quantity =
+        frequency ? ResponseSpec::Quantity::kFrequency : ResponseSpec::Quantity::kBucklingFactor;
+    const auto analysis = analysis_for(
+        r, study, frequency ? AnalysisSpec::Type::kModal : AnalysisSpec::Type::kBuckling, *q);
     const auto mode = r.integer("mode", true, 1);
-    if (!mode) return std::nullopt;
+    if (!mode || !analysis) return std::nullopt;
+    s.analysis = *analysis;
     s.mode = static_cast<int>(std::min(*mode, 1000000L));
-    const int modal = find_analysis(study, AnalysisSpec::Type::kModal);
-    if (modal >= 0 && s.mode > study.analyses[modal].modal.modes)
-      r.error("mode", "the modal analysis computes " +
-                          std::to_string(study.analyses[modal].modal.modes) +
+    const AnalysisSpec& a = study.analyses[*analysis];
+    const int computed = frequency ? a.modal.modes : a.buckling.modes;
+    if (s.mode > computed)
+      r.error("mode", "the " + std::string(type_name(a.type)) + " analysis \"" + a.name +
+                          "\" computes " + std::to_string(computed) +
                           " modes; raise its \"modes\" to at least " + std::to_string(s.mode));
     return s;
   }
   if (*q == "displacement" || *q == "peak_displacement") {
     s.quantity = *q == "displacement" ? ResponseSpec::Quantity::kDisplacement
                                       : ResponseSpec::Quantity::kPeakDisplacement;
-    require(r, study, *q == "displacement" ? "static" : "transient", *q);
+    const auto analysis = analysis_for(
+        r, study,
+        *q == "displacement" ? AnalysisSpec::Type::kStatic : AnalysisSpec::Type::kTransient, *q);
     const auto body = body_named(r, "body", model);
     const auto point = r.vec3("point", false);
     const auto direction = unit_vector(r, "direction");
-    if (!body || !direction) return std::nullopt;
+    if (!body || !direction || !analysis) return std::nullopt;
+    s.analysis = *analysis;
     s.body = *body;
     s.point = point.value_or(model->bodies[*body].position);
     s.direction = *direction;
@@ -126,22 +180,24 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
   }
   if (*q == "rotation") {
     s.quantity = ResponseSpec::Quantity::kRotation;
-    require(r, study, "static", *q);
+    const auto analysis = analysis_for(r, study, AnalysisSpec::Type::kStatic, *q);
     const auto body = body_named(r, "body", model);
     const auto axis = unit_vector(r, "axis");
-    if (!body || !axis) return std::nullopt;
+    if (!body || !axis || !analysis) return std::nullopt;
+    s.analysis = *analysis;
     s.body = *body;
     s.direction = *axis;
     return s;
   }
   if (*q == "element_force") {
     s.quantity = ResponseSpec::Quantity::kElementForce;
-    require(r, study, "static", *q);
+    const auto analysis = analysis_for(r, study, AnalysisSpec::Type::kStatic, *q);
     const auto component = r.choice("component", true, kComponents);
     const auto end = r.integer("end", false, 1);
     if (end && *end > 2) r.error("end", "must be 1 or 2");
     const auto element = element_named(r, model, static_cast<int>(end.value_or(1)));
-    if (!component || !element || (end && *end > 2)) return std::nullopt;
+    if (!component || !element || (end && *end > 2) || !analysis) return std::nullopt;
+    s.analysis = *analysis;
     s.component = static_cast<int>(std::find(kComponents.begin(), kComponents.end(), *component) -
                                    kComponents.begin());
     s.element = *element;
@@ -149,7 +205,8 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
   }
   // max_stress
   s.quantity = ResponseSpec::Quantity::kMaxStress;
-  require(r, study, "static", *q);
+  const auto analysis = analysis_for(r, study, AnalysisSpec::Type::kStatic, *q);
+  if (analysis) s.analysis = *analysis;
   std::vector<std::string> names;
   if (const Json* list = r.member("elements", false)) {
     if (!list->is_array() || list->empty()) {
@@ -164,7 +221,7 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
       names.push_back((*list)[i].get<std::string>());
     }
   }
-  if (!model) return std::nullopt;
+  if (!model || !analysis) return std::nullopt;
   for (size_t n = 0; n < names.size(); ++n) {
     bool known = false;
     for (const Beam& b : model->beams) known = known || b.group == names[n];

@@ -28,10 +28,11 @@ double PointTracker::value(const Data& data) const {
   return (p.u + (p.A * offset_ - initial_lever_)).dot(direction_);
 }
 
-void static_responses(const Study& study, const Model& model, const Data& data,
+void static_responses(const Study& study, int analysis, const Model& model, const Data& data,
                       std::vector<double>& values) {
   for (size_t k = 0; k < study.responses.size(); ++k) {
     const ResponseSpec& r = study.responses[k];
+    if (r.analysis != analysis) continue;
     switch (r.quantity) {
       case ResponseSpec::Quantity::kDisplacement:
         values[k] = PointTracker(model, r).value(data);
@@ -60,12 +61,22 @@ void static_responses(const Study& study, const Model& model, const Data& data,
   }
 }
 
-void modal_responses(const Study& study, const ModalResult& result, std::vector<double>& values) {
+void modal_responses(const Study& study, int analysis, const ModalResult& result,
+                     std::vector<double>& values) {
   for (size_t k = 0; k < study.responses.size(); ++k) {
     const ResponseSpec& r = study.responses[k];
-    if (r.quantity != ResponseSpec::Quantity::kFrequency) continue;
+    if (r.analysis != analysis || r.quantity != ResponseSpec::Quantity::kFrequency) continue;
     const Mode* mode = elastic_mode(result, r.mode);
     values[k] = mode ? mode->frequency_hz : std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+void buckling_responses(const Study& study, int analysis, const BucklingResult& result,
+                        std::vector<double>& values) {
+  for (size_t k = 0; k < study.responses.size(); ++k) {
+    const ResponseSpec& r = study.responses[k];
+    if (r.analysis != analysis || r.quantity != ResponseSpec::Quantity::kBucklingFactor) continue;
+    values[k] = buckling_factor(result, r.mode);
   }
 }
 

@@ -25,12 +25,18 @@ class PointTracker {
   Vec3 direction_;
 };
 
-// Fills the static responses (displacement, rotation, element_force, max_stress) from the
-// equilibrium in data; others are left alone.
-void static_responses(const Study& study, const Model& model, const Data& data,
+// Fills the static responses (displacement, rotation, element_force, max_stress) of analysis
+// `analysis` (an index into study.analyses) from the equilibrium in data; others are left alone.
+void static_responses(const Study& study, int analysis, const Model& model, const Data& data,
                       std::vector<double>& values);
 
-// Fills the frequency responses from a modal result.
-void modal_responses(const Study& study, const ModalResult& result, std::vector<double>& values);
+// Fills the frequency responses of modal analysis `analysis`.
+void modal_responses(const Study& study, int analysis, const ModalResult& result,
+                     std::vector<double>& values);
+
+// Fills the buckling_factor responses of buckling analysis `analysis` (+infinity for a mode the
+// loads do not buckle).
+void buckling_responses(const Study& study, int analysis, const BucklingResult& result,
+                        std::vector<double>& values);
 
 }  // namespace beamrail

@@ -41,10 +41,10 @@ void TimeseriesWriter::write(const TransientSample& sample, const Data& data) {
   if (!table_.good()) throw std::runtime_error(table_.error());
 }
 
-bool write_static_tables(const std::filesystem::path& directory, const Model& model,
-                         const Data& data, std::string* error) {
+bool write_static_tables(const std::filesystem::path& directory, const std::string& prefix,
+                         const Model& model, const Data& data, std::string* error) {
   CsvWriter displacements;
-  if (!displacements.open(directory / "static_displacements.csv",
+  if (!displacements.open(directory / (prefix + "static_displacements.csv"),
                           {"body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
     return false;
   for (int i : model.free_bodies) {
@@ -55,7 +55,7 @@ bool write_static_tables(const std::filesystem::path& directory, const Model& mo
                        format_number(r(0)), format_number(r(1)), format_number(r(2))});
   }
   CsvWriter forces;
-  if (!forces.open(directory / "element_forces.csv",
+  if (!forces.open(directory / (prefix + "element_forces.csv"),
                    {"element", "end", "fx", "fy", "fz", "mx", "my", "mz"}, error, true))
     return false;
   const auto rows = [&](const std::string& name, const EndForces& f) {
@@ -73,11 +73,12 @@ bool write_static_tables(const std::filesystem::path& directory, const Model& mo
   return displacements.commit(error) && forces.commit(error);
 }
 
-bool write_modal_tables(const std::filesystem::path& directory, const Model& model,
-                        const ModalResult& result, std::string* error) {
+bool write_modal_tables(const std::filesystem::path& directory, const std::string& prefix,
+                        const Model& model, const ModalResult& result, std::string* error) {
   CsvWriter modes, shapes;
-  if (!modes.open(directory / "modes.csv", {"mode", "frequency_hz", "kind"}, error, true) ||
-      !shapes.open(directory / "mode_shapes.csv",
+  if (!modes.open(directory / (prefix + "modes.csv"), {"mode", "frequency_hz", "kind"}, error,
+                  true) ||
+      !shapes.open(directory / (prefix + "mode_shapes.csv"),
                    {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
     return false;
   int elastic = 0;
@@ -95,6 +96,26 @@ bool write_modal_tables(const std::filesystem::path& directory, const Model& mod
     }
   }
   return modes.commit(error) && shapes.commit(error);
+}
+
+bool write_buckling_tables(const std::filesystem::path& directory, const std::string& prefix,
+                           const Model& model, const BucklingResult& result, std::string* error) {
+  CsvWriter factors, shapes;
+  if (!factors.open(directory / (prefix + "buckling.csv"), {"mode", "factor"}, error, true) ||
+      !shapes.open(directory / (prefix + "buckling_shapes.csv"),
+                   {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
+    return false;
+  for (size_t m = 0; m < result.modes.size(); ++m) {
+    const BucklingMode& mode = result.modes[m];
+    const std::string number = std::to_string(m + 1);
+    factors.row({number, format_number(mode.factor)});
+    for (int k = 0; k < model.n_free(); ++k) {
+      std::vector<std::string> row{number, model.bodies[model.free_bodies[k]].name};
+      for (int c = 0; c < 6; ++c) row.push_back(format_number(mode.shape(6 * k + c)));
+      shapes.row(row);
+    }
+  }
+  return factors.commit(error) && shapes.commit(error);
 }
 
 }  // namespace beamrail

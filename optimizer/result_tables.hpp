@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/analysis/buckling_analysis.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/transient.hpp"
 #include "optimizer/tables.hpp"
@@ -38,15 +39,23 @@ class TimeseriesWriter {
 // Rows are handed to the system at least this often while a time series is written.
 inline constexpr std::chrono::seconds kTimeseriesFlushInterval{1};
 
+// The tables of one analysis go to `directory`, their file names preceded by `prefix` ("" for an
+// analysis named after its type, else "<name>."). Each replaces the previous one whole (written
+// beside it and renamed).
+
 // static_displacements.csv (free bodies: dx, dy, dz and rotation vector rx, ry, rz) and
-// element_forces.csv (end forces of every beam and rail, element axes). Each table replaces the
-// previous one whole (written beside it and renamed).
-bool write_static_tables(const std::filesystem::path& directory, const Model& model,
-                         const Data& data, std::string* error);
+// element_forces.csv (end forces of every beam and rail, element axes).
+bool write_static_tables(const std::filesystem::path& directory, const std::string& prefix,
+                         const Model& model, const Data& data, std::string* error);
 
 // modes.csv (mode, frequency_hz, kind; rigid-body modes first with mode 0) and mode_shapes.csv
-// (elastic modes, M-normalized, per free body), each replacing the previous one whole.
-bool write_modal_tables(const std::filesystem::path& directory, const Model& model,
-                        const ModalResult& result, std::string* error);
+// (elastic modes, M-normalized, per free body).
+bool write_modal_tables(const std::filesystem::path& directory, const std::string& prefix,
+                        const Model& model, const ModalResult& result, std::string* error);
+
+// buckling.csv (mode, factor) and buckling_shapes.csv (mode, body, dx .. rz: the shape with its
+// largest translation, or rotation times the characteristic length, 1).
+bool write_buckling_tables(const std::filesystem::path& directory, const std::string& prefix,
+                           const Model& model, const BucklingResult& result, std::string* error);
 
 }  // namespace beamrail

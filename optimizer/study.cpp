@@ -1,15 +1,88 @@
 #include "optimizer/study.hpp"
 
 #include <algorithm>
+#include <map>
+#include <set>
 
 #include "core/scene/scene_loader.hpp"
 
 namespace beamrail {
+
+const char* type_name(AnalysisSpec::Type type) {
+  switch (type) {
+    case AnalysisSpec::Type::kStatic:
+      return "static";
+    case AnalysisSpec::Type::kModal:
+      return "modal";
+    case AnalysisSpec::Type::kBuckling:
+      return "buckling";
+    case AnalysisSpec::Type::kTransient:
+      break;
+  }
+  return "transient";
+}
+
+std::string table_file(const AnalysisSpec& analysis, const std::string& table) {
+  return analysis.name == type_name(analysis.type) ? table : analysis.name + "." + table;
+}
+
 int find_analysis(const Study& study, AnalysisSpec::Type type) {
   for (size_t i = 0; i < study.analyses.size(); ++i)
     if (study.analyses[i].type == type) return static_cast<int>(i);
   return -1;
 }
+
+int find_analysis(const Study& study, const std::string& name) {
+  for (size_t i = 0; i < study.analyses.size(); ++i)
+    if (study.analyses[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+Model model_for_case(const Model& model, const std::string& load_case) {
+  return with_loads(
+      model, [&](const Load& load) { return applies_in_case(load, load_case); }, true);
+}
+
+namespace {
+
+// Default names (the type, numbered when repeated); a name used twice is reported where it is
+// given (or at the type of an analysis whose default name another one took).
+void name_analyses(Study& study, Diagnostics& diag) {
+  std::map<AnalysisSpec::Type, int> count, seen;
+  for (const AnalysisSpec& a : study.analyses) ++count[a.type];
+  std::set<std::string> given, used;
+  for (const AnalysisSpec& a : study.analyses)
+    if (!a.name.empty()) given.insert(a.name);
+  for (AnalysisSpec& a : study.analyses) {
+    const int k = ++seen[a.type];
+    const bool explicit_name = !a.name.empty();
+    if (!explicit_name)
+      a.name = count[a.type] == 1 ? type_name(a.type)
+                                  : std::string(type_name(a.type)) + "_" + std::to_string(k);
+    if (used.insert(a.name).second && (explicit_name || !given.count(a.name))) continue;
+    diag.error(a.where.file, (a.where / (explicit_name ? "name" : "type")).pointer,
+               "analysis name \"" + a.name + "\" is used twice" +
+                   (explicit_name ? std::string()
+                                  : " (it is this analysis's default name): give it a \"name\""));
+  }
+}
+
+// The load case an analysis names must be one the scene's loads give.
+void check_load_cases(const Study& study, Diagnostics& diag) {
+  for (const AnalysisSpec& a : study.analyses) {
+    if (a.load_case.empty()) continue;
+    const auto& cases = study.model.load_cases;
+    if (std::find(cases.begin(), cases.end(), a.load_case) != cases.end()) continue;
+    std::string known;
+    for (const std::string& c : cases) known += (known.empty() ? "\"" : ", \"") + c + "\"";
+    diag.error(a.where.file, (a.where / "load_case").pointer,
+               "no load has the case \"" + a.load_case + "\"" +
+                   (known.empty() ? std::string(" (no load of the scene gives a \"case\")")
+                                  : " (the loads' cases: " + known + ")"));
+  }
+}
+
+}  // namespace
 
 std::optional<Study> load_study(const Json& document, const std::string& file,
                                 const std::filesystem::path& directory, Diagnostics& diag) {
@@ -87,9 +160,13 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
           if (auto a =
                   read_analysis((*list)[i], root / "analyses" / i, model ? &*model : nullptr, diag))
             study.analyses.push_back(*a);
+        name_analyses(study, diag);
       }
     }
-    if (model) study.model = std::move(*model);
+    if (model) {
+      study.model = std::move(*model);
+      check_load_cases(study, diag);
+    }
 
     if (const Json* responses = r.member("responses", false)) {
       if (!responses->is_object()) {

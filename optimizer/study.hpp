@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/analysis/buckling_analysis.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
@@ -18,15 +19,32 @@
 namespace beamrail {
 
 struct AnalysisSpec {
-  enum class Type { kTransient, kStatic, kModal };
+  enum class Type { kTransient, kStatic, kModal, kBuckling };
   Type type = Type::kTransient;
+  // Unique in the study; default: the type, numbered from 1 when the study has several analyses of
+  // that type ("static_1", "static_2"). Responses and table names use it.
+  std::string name;
+  // The loads it applies: those without a case and those of this case ("": those without a case);
+  // gravity always. A buckling analysis scales the case's loads and holds the others constant
+  // (without a case: it scales the loads without a case and gravity).
+  std::string load_case;
   TransientOptions transient;
   StaticOptions statics;
   ModalOptions modal;
+  BucklingOptions buckling;
   bool about_static = false;  // modal: linearize about the static equilibrium (else: initial)
   bool verify = false;  // transient: rerun at tolerances ten times tighter and report the error
+  // transient: start at the static equilibrium of the loads at t = 0 (else: the scene's state)
+  bool initial_static = false;
   Where where;
 };
+
+// "transient", "static", "modal", "buckling".
+const char* type_name(AnalysisSpec::Type type);
+
+// The file an analysis writes its table to: `table` ("static_displacements.csv") for an analysis
+// named after its type, else "<name>.<table>".
+std::string table_file(const AnalysisSpec& analysis, const std::string& table);
 
 // Where an element's end forces are read: element kind and index, and which end (1 or 2).
 struct ElementEnd {
@@ -38,6 +56,7 @@ struct ElementEnd {
 struct ResponseSpec {
   enum class Quantity {
     kFrequency,         // modal: Hz of elastic mode `mode`
+    kBucklingFactor,    // buckling: load factor of mode `mode`
     kDisplacement,      // static: displacement of a body point along `direction` [m]
     kRotation,          // static: rotation of a body about `direction` [rad]
     kPeakDisplacement,  // transient: largest |displacement . direction| of a body point [m]
@@ -47,7 +66,8 @@ struct ResponseSpec {
   };
   std::string name;
   Quantity quantity = Quantity::kMass;
-  int mode = 1;                    // frequency: 1-based elastic mode
+  int analysis = -1;               // index of the analysis that produces it (-1: none, mass)
+  int mode = 1;                    // frequency, buckling_factor: 1-based mode
   int body = 0;                    // displacement-like quantities: body index
   Vec3 point = Vec3::Zero();       // global point in the initial configuration [m]
   Vec3 direction = Vec3::UnitX();  // unit vector, global (the axis of a rotation)
@@ -79,6 +99,13 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
 
 // The index of the first analysis of the given type, or -1.
 int find_analysis(const Study& study, AnalysisSpec::Type type);
+
+// The index of the analysis named `name`, or -1.
+int find_analysis(const Study& study, const std::string& name);
+
+// The model an analysis of `load_case` sees: the loads without a case and those of the case,
+// gravity (a copy only when the scene has loads of other cases).
+Model model_for_case(const Model& model, const std::string& load_case);
 
 // The analysis types and response quantities a study file may name.
 extern const std::vector<std::string> kAnalysisTypes;

@@ -38,13 +38,16 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
   s["model"] = model_summary(model);
   nlohmann::json analyses = nlohmann::json::array();
   for (const AnalysisReport& a : ev.analyses) {
-    nlohmann::json j{{"type", a.type},
+    nlohmann::json j{{"name", a.name},
+                     {"type", a.type},
                      {"status", a.ok            ? "ok"
                                 : a.interrupted ? "interrupted"
                                 : a.timed_out   ? "timeout"
                                                 : "failed"},
                      {"message", a.message},
-                     {"wall_seconds", a.wall_seconds}};
+                     {"wall_seconds", a.wall_seconds},
+                     {"tables", a.tables}};
+    if (!a.load_case.empty()) j["load_case"] = a.load_case;
     if (a.type == "transient") {
       j["integrator"] = a.integrator;
       j["linear_solver"] = a.linear_solver;
@@ -55,8 +58,10 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["nonlinear_failures"] = a.stats.nonlinear_failures;
       j["error_test_failures"] = a.stats.error_test_failures;
       j["t_reached"] = a.t_reached;
+      j["initial"] = a.initial;
       j["energy_initial"] = json_number(a.energy_initial);
       j["energy_final"] = json_number(a.energy_final);
+      j["energy_max_change"] = json_number(a.energy_max_change);
       j["energy_max_relative_change"] = json_number(a.energy_max_relative_change);
       if (const auto& v = a.verification)
         j["verification"] = {
@@ -89,7 +94,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       if (a.type == "static")
         j.update(st);
       else
-        j["equilibrium"] = st;
+        j[a.type == "transient" ? "initial_equilibrium" : "equilibrium"] = st;
     }
     if (a.type == "modal") {
       j["about"] = a.about;
@@ -100,6 +105,13 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["largest_noise"] = json_number(a.noise);
       j["stiffness_asymmetry"] = json_number(a.asymmetry);
       j["eigenproblem"] = a.nonsymmetric ? "non-symmetric" : "symmetric";
+    }
+    if (a.type == "buckling") {
+      j["eigensolver"] = a.eigensolver;
+      nlohmann::json factors = nlohmann::json::array();
+      for (double f : a.factors) factors.push_back(json_number(f));
+      j["factors"] = factors;
+      j["positive_factors"] = a.positive_factors;
     }
     analyses.push_back(j);
   }

@@ -29,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 constexpr double kStep = 1e-3;
 
 std::string text(const char* pattern, double x) {
-  char buf[200];
+  char buf[400];
   std::snprintf(buf, sizeof buf, pattern, x);
   return buf;
 }

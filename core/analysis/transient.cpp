@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <stdexcept>
 
 #include "core/analysis/deformation_check.hpp"
 #include "core/analysis/integrators.hpp"
@@ -53,7 +54,14 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
                                      std::chrono::duration<double>(options.max_seconds));
     const long n = model.n_states;
     SerialVector y(n, ctx);
-    initial_state(model, y.data());
+    if (options.initial_state.empty())
+      initial_state(model, y.data());
+    else if (static_cast<long>(options.initial_state.size()) == n)
+      std::copy(options.initial_state.begin(), options.initial_state.end(), y.data());
+    else
+      throw std::invalid_argument("the initial state has " +
+                                  std::to_string(options.initial_state.size()) +
+                                  " entries; the model has " + std::to_string(n) + " states");
     std::string error;
     const std::unique_ptr<Integrator> integrator = make_integrator(io, context, ctx, y, &error);
     if (!integrator) {

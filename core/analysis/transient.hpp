@@ -51,6 +51,9 @@ struct TransientOptions {
   // Shares the sparse Jacobian structure and KLU ordering between runs of one topology (designs,
   // reruns); nullptr: this run analyses its own.
   SparseStructureCache* structure_cache = nullptr;
+  // The state at t = 0 (dim model.n_states; initial_state_at makes one from a static
+  // equilibrium); empty: the model's initial state.
+  std::vector<double> initial_state;
 };
 
 // Energies at one output time [J].

@@ -53,4 +53,16 @@ void initial_state(const Model& model, double* y) {
   }
 }
 
+void initial_state_at(const Model& model, const Data& configuration, double* y) {
+  initial_state(model, y);
+  for (int k = 0; k < model.n_free(); ++k) {
+    const int i = model.free_bodies[k];
+    double* s = y + kStatesPerBody * k;
+    const Vec3 c = centre(model, configuration, i);
+    const Vec4 q = configuration.q[i] / configuration.q[i].norm();
+    for (int j = 0; j < 3; ++j) s[j] = c(j);
+    for (int j = 0; j < 4; ++j) s[3 + j] = q(j);
+  }
+}
+
 }  // namespace beamrail

@@ -47,4 +47,8 @@ void set_state(const Model& model, Data& data, const double* y);
 // Writes the initial state of the free bodies into y (dim model.n_states).
 void initial_state(const Model& model, double* y);
 
+// The initial state with the centres and orientations of `configuration` (a static equilibrium,
+// say) and the scene's initial velocities, into y (dim model.n_states).
+void initial_state_at(const Model& model, const Data& configuration, double* y);
+
 }  // namespace beamrail

@@ -144,6 +144,52 @@ TEST(Buckling, ClampedClampedColumnWithARailGuidingItsTopConvergesToEuler) {
                       [](int n) { return clamped_column(n, 100.0); });
 }
 
+// A portal frame: columns of height h clamped at the ground, a girder of length L rigidly joined
+// to their tops, a load P down on each top. Its sway mode buckles at k h cot(k h) = -6 rho,
+// k = sqrt(P / EIc), rho = (EIb / L) / (EIc / h) (slope-deflection with stability functions; its
+// limits are the cantilever's pi^2 EI / (4 h^2) for rho -> 0 and the guided column's
+// pi^2 EI / h^2 for rho -> infinity). For h = 1 m, L = 1.5 m and one section (rho = 2/3, a 20 mm
+// steel square in the frame's plane): k h = 2.570431560335956501, P_cr = 18499.93153784 N, and
+// the joints turn by 0.7546943546742 rad per metre of sway (a second derivation by a consistent
+// frame element model converges to both at order 4, to 3e-13). The out-of-plane stiffness is
+// 100x the in-plane one and the area 200x the square's, so that the lowest mode is the in-plane
+// sway and the columns' shortening does not shift it.
+Model portal_frame(int n) {
+  constexpr double b = 0.02, i = b * b * b * b / 12.0;
+  Scene s;
+  s.material("steel", kE, kG, 7850).custom("member", 200 * b * b, 100 * i, i, 100 * i);
+  s.body("left", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0, 0, 1.0));
+  s.body("right", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(1.5, 0, 1.0));
+  s.beam("column_left", "ground", "left", Vec3::Zero(), Vec3(0, 0, 1.0), "steel", "member");
+  s.last_beam()["segments"] = n;
+  s.beam("column_right", "ground", "right", Vec3(1.5, 0, 0), Vec3(1.5, 0, 1.0), "steel", "member");
+  s.last_beam()["segments"] = n;
+  s.beam("girder", "left", "right", Vec3(0, 0, 1.0), Vec3(1.5, 0, 1.0), "steel", "member");
+  s.last_beam()["segments"] = n;
+  s.force("left", Vec3(0, 0, -1000.0));
+  s.force("right", Vec3(0, 0, -1000.0));
+  return s.model();
+}
+
+TEST(Buckling, PortalFrameSwaysAtTheSlopeDeflectionLoad) {
+  constexpr double exact = 18499.93153784, joint_turn = 0.7546943546742;
+  expect_second_order("portal sway", exact, 1000.0, 1e-5, portal_frame);
+  // The shape: both tops sway alike along x, and turn about y by joint_turn per metre.
+  const Model m = portal_frame(64);
+  const BucklingResult r = buckle(m, "");
+  ASSERT_TRUE(r.ok) << r.message;
+  const auto at = [&](const char* name) {
+    return r.modes[0].shape.segment<6>(6 * m.bodies[testing::body_index(m, name)].free_index);
+  };
+  const Vec6 left = at("left"), right = at("right");
+  std::printf("sway shape: left dx %.9f ry %.9f, right dx %.9f ry %.9f; ry / dx %.9f\n", left(0),
+              left(4), right(0), right(4), left(4) / left(0));
+  EXPECT_NEAR(right(0) / left(0), 1.0, 1e-9);
+  EXPECT_NEAR(right(4) / left(4), 1.0, 1e-9);
+  // Discretization error at 64 segments: as the factor's, ~1e-4.
+  EXPECT_NEAR(std::abs(left(4) / left(0)) / joint_turn, 1.0, 1e-3);
+}
+
 // A preload P0 (no case) stays; the factor multiplies only the case's load P1, so the column
 // buckles at P0 + lambda P1 = P_cr of the same column without a preload.
 TEST(Buckling, TheFactorScalesOnlyTheLoadsOfTheCase) {

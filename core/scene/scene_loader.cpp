@@ -1,6 +1,7 @@
 #include "core/scene/scene_loader.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string>
@@ -17,15 +18,14 @@ PointMass lumped(double mass, const Vec3& point, const Mat3& frame, const Vec3& 
 }
 
 // Splits every segmented beam into `segments` sub-beams joined by generated interior bodies, and
-// collects the half-segment masses that go to the end bodies.
+// collects the half-segment masses that go to the end bodies. An element with a density that is
+// not split carries its mass lumped (docs/model.md "Mass"): a beam as one segment (half its mass
+// at each free end body), a rail wholly on body 1 (the rail's body; the carriage slides along it)
+// as a slender rod between its points. The dynamics then see the mass the mass response counts.
 void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>>& extra,
                            std::vector<ElementSpec>& out) {
   for (const ElementSpec& e : specs.elements) {
-    if (e.segments <= 0) {
-      out.push_back(e);
-      continue;
-    }
-    const long n = e.segments;
+    const long n = std::max(e.segments, 1L);
     const Vec3 step = (e.p2 - e.p1) / static_cast<double>(n);
     const double ls = step.norm();
     const double rho = e.material.density;
@@ -39,6 +39,15 @@ void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>
       return Vec3(rho * a * (s.iy + s.iz), rho * a * s.iy + m * a * a / 12.0,
                   rho * a * s.iz + m * a * a / 12.0);
     };
+    if (e.segments <= 0) {
+      out.push_back(e);
+      if (!(ms > 0.0)) continue;
+      if (e.rail) {
+        if (!specs.bodies[e.body1].fixed)
+          extra[e.body1].push_back(lumped(ms, 0.5 * (e.p1 + e.p2), frame, slice(ls)));
+        continue;
+      }
+    }
     // Half segment about the end node: its slice inertia plus m (a/2)^2 for the bending axes.
     Vec3 half = slice(0.5 * ls);
     const double mh = 0.5 * ms;
@@ -46,6 +55,7 @@ void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>
     half(2) += mh * 0.0625 * ls * ls;
     if (!specs.bodies[e.body1].fixed) extra[e.body1].push_back(lumped(mh, e.p1, frame, half));
     if (!specs.bodies[e.body2].fixed) extra[e.body2].push_back(lumped(mh, e.p2, frame, half));
+    if (e.segments <= 0) continue;  // an unsplit beam: its halves are placed
 
     // Interior bodies share the element's orientation; their velocities blend the ends'.
     // Copies: adding the interior bodies below may reallocate specs.bodies.

@@ -27,7 +27,12 @@ constexpr double kE = 2.1e11, kG = 8.0769e10, kPi = std::numbers::pi;
 // a tip torque about z.
 Scene bent_cantilever(double torque, int segments) {
   Scene s;
-  s.material("steel", kE, kG, 7850).square("sq10", 0.01);
+  // Massless unless segmented (a beam with a density carries its mass).
+  if (segments > 0)
+    s.material("steel", kE, kG, 7850);
+  else
+    s.material("steel", kE, kG);
+  s.square("sq10", 0.01);
   s.body("tip", 1.0, Vec3(1e-4, 1e-4, 1e-4), Vec3(1, 0, 0));
   s.beam("arm", "ground", "tip", Vec3::Zero(), Vec3(1, 0, 0), "steel", "sq10");
   if (segments > 0) s.last_beam()["segments"] = segments;

@@ -367,7 +367,7 @@ StopMeaning meaning_of(int index, nlopt_result result, bool stopped_by_us,
 int Optimization::report(const Record* best, const std::vector<Start>& starts, double wall,
                          const std::string& history_error) const {
   const int signal = stop_requested();
-  std::vector<std::string> warnings, errors;
+  std::vector<std::string> warnings = study_.input_warnings, errors;
   bool stopped = false;
   for (const Start& st : starts) {
     const StopMeaning m = meaning_of(st.index, st.result, st.stopped, st.message);
@@ -459,7 +459,8 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
     }
   }
   ok = ok && write_file_atomically(settings_.output / "summary.json", s.dump(2) + "\n", &error);
-  for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
+  for (size_t k = study_.input_warnings.size(); k < warnings.size(); ++k)
+    std::cerr << "warning: " << warnings[k] << "\n";
   if (!ok) {
     std::cerr << "beamrail: " << error << "\n";
     return 1;

@@ -86,7 +86,7 @@ void check_load_cases(const Study& study, Diagnostics& diag) {
 
 std::optional<Study> load_study(const Json& document, const std::string& file,
                                 const std::filesystem::path& directory, Diagnostics& diag) {
-  const size_t errors_before = diag.size();
+  const size_t errors_before = diag.size(), warnings_before = diag.warnings().size();
   Study study;
   study.file = file;
   study.directory = directory;
@@ -185,6 +185,8 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
   }
 
   if (diag.size() > errors_before || !model) return std::nullopt;
+  const std::vector<std::string> lines = diag.warning_lines();
+  study.input_warnings.assign(lines.begin() + static_cast<long>(warnings_before), lines.end());
   return study;
 }
 

@@ -87,6 +87,9 @@ struct Study {
   std::vector<AnalysisSpec> analyses;
   std::vector<ResponseSpec> responses;
   std::optional<DesignStudy> design;  // without it the analyses run once
+  // What in the study file looks mistyped but may be meant ("file:/pointer: message"): printed
+  // by `check` and `run`, and listed among the warnings of summary.json.
+  std::vector<std::string> input_warnings;
 };
 
 // Reads, validates and builds a study from a file. Reports every problem; nullopt if any.

@@ -117,7 +117,9 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
   }
   s["analyses"] = analyses;
   s["wall_seconds"] = ev.wall_seconds;
-  s["warnings"] = ev.warnings;
+  std::vector<std::string> warnings = study.input_warnings;
+  warnings.insert(warnings.end(), ev.warnings.begin(), ev.warnings.end());
+  s["warnings"] = warnings;
   return s;
 }
 

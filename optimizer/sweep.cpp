@@ -102,6 +102,7 @@ int run_sweep(const Study& study, const RunSettings& settings) {
                                      std::to_string(finished.load()) + " of " +
                                      std::to_string(designs.size()) + " designs"
                                : "";
+  s["warnings"] = study.input_warnings;
   s["designs"] = designs.size();
   s["designs_in_table"] = finished.load();
   s["evaluated_now"] = evaluated.load();

@@ -47,6 +47,7 @@ int run_work_precision(const Study& study, const RunSettings& settings) {
   summary["file"] = study.file;
   summary["beamrail_version"] = kVersion;
   summary["type"] = "work_precision";
+  summary["warnings"] = study.input_warnings;
   // The summary of a run that ends early (status, message); false when it cannot be written.
   const auto write_summary = [&](const std::string& status, const std::string& message) {
     summary["status"] = status;

@@ -68,19 +68,36 @@ void Diagnostics::error(std::string file, std::string pointer, std::string messa
   items_.push_back({std::move(file), std::move(pointer), std::move(message)});
 }
 
+void Diagnostics::warning(std::string file, std::string pointer, std::string message) {
+  warnings_.push_back({std::move(file), std::move(pointer), std::move(message)});
+}
+
+namespace {
+
+std::string line_of(const Diagnostic& d) {
+  std::string out;
+  append_one_line(out, d.file);
+  out += ':';
+  if (!d.pointer.empty()) {
+    append_one_line(out, d.pointer);
+    out += ':';
+  }
+  out += ' ';
+  append_one_line(out, d.message);
+  return out;
+}
+
+}  // namespace
+
 std::string Diagnostics::format() const {
   std::string out;
-  for (const Diagnostic& d : items_) {
-    append_one_line(out, d.file);
-    out += ':';
-    if (!d.pointer.empty()) {
-      append_one_line(out, d.pointer);
-      out += ':';
-    }
-    out += ' ';
-    append_one_line(out, d.message);
-    out += '\n';
-  }
+  for (const Diagnostic& d : items_) out += line_of(d) + '\n';
+  return out;
+}
+
+std::vector<std::string> Diagnostics::warning_lines() const {
+  std::vector<std::string> out;
+  for (const Diagnostic& d : warnings_) out.push_back(line_of(d));
   return out;
 }
 

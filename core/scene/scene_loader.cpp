@@ -182,6 +182,7 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     read_loads(r, specs);
   }
   if (diag.size() > errors_before) return std::nullopt;
+  check_plausibility(specs, where, diag);
 
   std::vector<std::vector<PointMass>> extra(specs.bodies.size());
   std::vector<ElementSpec> elements;

@@ -411,6 +411,8 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
     e.name = *name, e.body1 = *b1, e.body2 = *b2, e.p1 = *p1, e.p2 = *p2, e.p3 = *p3;
     e.material = specs.materials.at(*material);
     e.section = specs.sections.at(*section);
+    e.material_name = *material;
+    e.section_name = *section;
     specs.n_segments += e.segments;
     specs.elements.push_back(e);
   });
@@ -451,6 +453,7 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     load.time = *time;
     specs.loads.push_back(load);
     specs.load_points.push_back(point.value_or(specs.bodies[*body].position));
+    specs.load_where.push_back(at);
   });
 }
 

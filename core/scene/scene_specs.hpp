@@ -47,6 +47,7 @@ struct ElementSpec {
   Vec3 p1, p2, p3;
   MaterialSpec material;
   SectionProperties section;
+  std::string material_name, section_name;
   double damping = 0.0;
   Formulation formulation = Formulation::kEnergy;
   long segments = 0;  // at most kMaxSegments, all elements together
@@ -70,6 +71,7 @@ struct SceneSpecs {
   long n_segments = 0;  // of the elements read so far (kMaxSegments + 1 once over the limit)
   std::vector<Load> loads;
   std::vector<Vec3> load_points;        // global application point of each load
+  std::vector<Where> load_where;        // where each load is given
   std::vector<std::string> load_cases;  // the case names loads give, in order of first use
 };
 
@@ -83,6 +85,12 @@ void read_sections(ObjectReader& scene, SceneSpecs& specs);
 void read_bodies(ObjectReader& scene, SceneSpecs& specs);
 void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails);
 void read_loads(ObjectReader& scene, SceneSpecs& specs);
+
+// Warnings (never errors) for what looks mistyped: members whose length, section area or mass is
+// two orders of magnitude or more from the median of the scene's members, and attachment or load
+// points far from their body (beyond 3 radii of gyration and the median member length). `scene`
+// locates the scene object (section pointers are built from it).
+void check_plausibility(const SceneSpecs& specs, const Where& scene, Diagnostics& diag);
 
 // The element frame (columns x, y, z in global axes) of points 1, 2, 3; nullopt when points 1
 // and 2 coincide or point 3 lies on the axis (reported at `where`).

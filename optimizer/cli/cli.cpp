@@ -117,6 +117,7 @@ int check(const RunArguments& args) {
     std::cerr << diag.format();
     return 2;
   }
+  for (const std::string& w : study->input_warnings) std::cerr << "warning: " << w << "\n";
   const Model& m = study->model;
   std::cout << args.study << ": ok (" << m.bodies.size() - 1 << " bodies, " << m.beams.size()
             << " beams, " << m.rails.size() << " rails, " << m.n_states << " states, "
@@ -181,6 +182,7 @@ int run(const RunArguments& args) {
     std::cerr << diag.format();
     return 2;
   }
+  for (const std::string& w : study->input_warnings) std::cerr << "warning: " << w << "\n";
   const std::filesystem::path out = args.output.empty()
                                         ? std::filesystem::path("results") / study->name
                                         : std::filesystem::path(args.output);

@@ -95,10 +95,12 @@ std::optional<DesignVariable> read_variable(const Json& value, const Where& wher
   }
   for (const std::string& pointer : v.pointers) ok = check_pointer(r, pointer, study) && ok;
   v.factors.assign(v.pointers.size(), 1.0);
-  if (r.member("factors", false)) {
-    const auto f = r.numbers("factors", true, static_cast<int>(v.pointers.size()));
+  v.offsets.assign(v.pointers.size(), 0.0);
+  for (auto [key, out] : {std::pair{"factors", &v.factors}, std::pair{"offsets", &v.offsets}}) {
+    if (!r.member(key, false)) continue;
+    const auto f = r.numbers(key, true, static_cast<int>(v.pointers.size()));
     if (f)
-      v.factors = *f;
+      *out = *f;
     else
       ok = false;
   }

@@ -14,8 +14,10 @@ namespace beamrail {
 struct DesignVariable {
   std::string name;
   std::vector<std::string> pointers;  // RFC 6901, into the study document (scene inlined)
-  std::vector<double> factors;        // number written at pointers[i] = factors[i] * value
-  std::vector<double> values;         // sweep/grid: explicit values
+  // The number written at pointers[i] is factors[i] * value + offsets[i] (an affine link: a mass
+  // m0 + k s following a width s).
+  std::vector<double> factors, offsets;
+  std::vector<double> values;  // sweep/grid: explicit values
   double lower = 0.0, upper = 0.0;
   int count = 0;                  // sweep/grid: lower..upper in count steps (when values is empty)
   std::optional<double> initial;  // optimize: first start's value

@@ -18,7 +18,7 @@ Json DesignEvaluator::document(const std::vector<double>& x) const {
   const auto& variables = study_.design->variables;
   for (size_t i = 0; i < pointers_.size(); ++i)
     for (size_t k = 0; k < pointers_[i].size(); ++k)
-      doc[pointers_[i][k]] = variables[i].factors[k] * x[i];
+      doc[pointers_[i][k]] = variables[i].factors[k] * x[i] + variables[i].offsets[k];
   return doc;
 }
 

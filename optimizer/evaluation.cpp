@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "core/analysis/stop_request.hpp"
+#include "optimizer/expressions.hpp"
 #include "optimizer/responses.hpp"
 #include "optimizer/result_tables.hpp"
 #include "optimizer/tables.hpp"
@@ -377,7 +378,7 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
   try {
     for (size_t k = 0; k < study.responses.size(); ++k)
       if (study.responses[k].quantity == ResponseSpec::Quantity::kMass)
-        ev.responses[k] = structural_mass(model);
+        ev.responses[k] = mass_response(model, study.responses[k]);
     Runner runner(study, model, options, ev, start);
     for (size_t i = 0; i < study.analyses.size(); ++i) {
       if (stop_requested()) {
@@ -388,6 +389,8 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
       }
       if (!runner.run(static_cast<int>(i))) break;
     }
+    for (std::string& w : evaluate_expressions(study, ev.responses))
+      ev.warnings.push_back(std::move(w));
   } catch (const std::exception& e) {
     ev.status = "failed";
     ev.message = e.what();

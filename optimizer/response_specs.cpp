@@ -6,8 +6,8 @@
 namespace beamrail {
 
 const std::vector<std::string> kResponseQuantities = {
-    "frequency", "displacement", "rotation",      "peak_displacement",
-    "mass",      "max_stress",   "element_force", "buckling_factor"};
+    "frequency",  "displacement",  "rotation",        "peak_displacement", "mass",
+    "max_stress", "element_force", "buckling_factor", "expression"};
 
 namespace {
 
@@ -70,6 +70,67 @@ std::optional<ElementEnd> element_named(ObjectReader& r, const Model* model, int
   if (found >= 0) return ElementEnd{false, found, end};
   r.error("element", "unknown element \"" + *name + "\"");
   return std::nullopt;
+}
+
+// A list of names under `key` (nullopt when absent; reported when not a non-empty array of
+// strings).
+std::optional<std::vector<std::string>> name_list(ObjectReader& r, const std::string& key,
+                                                  bool* ok) {
+  const Json* list = r.member(key, false);
+  if (!list) return std::nullopt;
+  std::vector<std::string> names;
+  if (!list->is_array() || list->empty()) {
+    r.error(key, "expected a non-empty array of names");
+    *ok = false;
+    return names;
+  }
+  for (size_t i = 0; i < list->size(); ++i) {
+    if (!(*list)[i].is_string()) {
+      const Where at = r.at(key) / i;
+      r.diagnostics().error(at.file, at.pointer, "expected a name");
+      *ok = false;
+      continue;
+    }
+    names.push_back((*list)[i].get<std::string>());
+  }
+  return names;
+}
+
+// mass: "bodies" (scene bodies' declared masses) and "elements" (beams and rails, rho S l) to
+// count; without either, the whole structure.
+bool read_mass_subset(ObjectReader& r, const Model* model, ResponseSpec& s) {
+  bool ok = true;
+  const auto bodies = name_list(r, "bodies", &ok);
+  const auto elements = name_list(r, "elements", &ok);
+  if (!bodies && !elements) return ok;
+  s.subset = true;
+  if (!model || !ok) return ok;
+  for (size_t n = 0; bodies && n < bodies->size(); ++n) {
+    int found = -1;
+    for (size_t i = 0; i < model->bodies.size(); ++i)
+      if (model->bodies[i].name == (*bodies)[n] && !model->bodies[i].generated)
+        found = static_cast<int>(i);
+    const Where at = r.at("bodies") / n;
+    if (found < 0)
+      r.diagnostics().error(at.file, at.pointer, "unknown body \"" + (*bodies)[n] + "\"");
+    else
+      s.mass_bodies.push_back(found);
+    ok = ok && found >= 0;
+  }
+  for (size_t n = 0; elements && n < elements->size(); ++n) {
+    const std::string& name = (*elements)[n];
+    bool found = false;
+    for (size_t i = 0; i < model->beams.size(); ++i)
+      if (model->beams[i].group == name) s.mass_beams.push_back(static_cast<int>(i)), found = true;
+    for (size_t i = 0; i < model->rails.size(); ++i)
+      if (model->rails[i].name == name) s.mass_rails.push_back(static_cast<int>(i)), found = true;
+    if (!found) {
+      const Where at = r.at("elements") / n;
+      r.diagnostics().error(at.file, at.pointer, "unknown beam or rail \"" + name + "\"");
+      ok = false;
+    }
+  }
+  return ok;
 }
 
 // Whether every entry of the study's "analyses" was read (then a name not among them is unknown).
@@ -137,12 +198,23 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
   const auto q = r.choice("quantity", true, kResponseQuantities);
   if (!q) {
     r.allow({"body", "point", "direction", "axis", "mode", "element", "component", "end",
-             "elements", "analysis"});
+             "elements", "analysis", "bodies", "expression"});
     return std::nullopt;
   }
   if (*q == "mass") {
     s.quantity = ResponseSpec::Quantity::kMass;
-    return s;
+    return read_mass_subset(r, model, s) ? std::optional<ResponseSpec>(s) : std::nullopt;
+  }
+  if (*q == "expression") {
+    s.quantity = ResponseSpec::Quantity::kExpression;
+    const auto text = r.string("expression", true);
+    if (!text) return std::nullopt;
+    if (text->empty() || text->size() > 10000) {
+      r.error("expression", "expected a formula of 1 to 10000 characters");
+      return std::nullopt;
+    }
+    s.expression = *text;
+    return s;  // its names are checked once every response is read (resolve_expressions)
   }
   if (*q == "frequency" || *q == "buckling_factor") {
     const bool frequency = *q == "frequency";

@@ -16,6 +16,21 @@ double structural_mass(const Model& model) {
   return m;
 }
 
+double mass_response(const Model& model, const ResponseSpec& spec) {
+  if (!spec.subset) return structural_mass(model);
+  double m = 0.0;
+  for (int i : spec.mass_bodies) m += model.bodies[i].declared_mass;
+  for (int i : spec.mass_beams) {
+    const Beam& e = model.beams[i];
+    m += e.density * e.section.area * e.ends.length;
+  }
+  for (int i : spec.mass_rails) {
+    const Rail& e = model.rails[i];
+    m += e.density * e.section.area * e.ends.length;
+  }
+  return m;
+}
+
 PointTracker::PointTracker(const Model& model, const ResponseSpec& spec)
     : body_(spec.body), direction_(spec.direction) {
   const Body& b = model.bodies[spec.body];

@@ -12,6 +12,9 @@ namespace beamrail {
 // Total structural mass: declared body masses plus rho S l of every beam and rail with a density.
 double structural_mass(const Model& model);
 
+// A mass response: the structural mass, or that of its subset of bodies and elements.
+double mass_response(const Model& model, const ResponseSpec& spec);
+
 // Displacement along a direction of a body point, from the initial configuration.
 class PointTracker {
  public:

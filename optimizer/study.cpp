@@ -5,6 +5,7 @@
 #include <set>
 
 #include "core/scene/scene_loader.hpp"
+#include "optimizer/expressions.hpp"
 
 namespace beamrail {
 
@@ -180,6 +181,7 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
             study.responses.push_back(*s);
       }
     }
+    resolve_expressions(study, diag);
     if (const Json* design = r.member("study", false))
       study.design = read_design_study(*design, root / "study", study, diag);
   }

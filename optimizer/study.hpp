@@ -63,6 +63,7 @@ struct ResponseSpec {
     kMass,              // structural mass [kg]
     kMaxStress,         // static: largest |N|/S + |My|/Wy + |Mz|/Wz over beams [Pa]
     kElementForce,      // static: one component of an element's end forces [N, N m]
+    kExpression,        // a formula over other responses (muparser syntax)
   };
   std::string name;
   Quantity quantity = Quantity::kMass;
@@ -74,6 +75,12 @@ struct ResponseSpec {
   ElementEnd element;              // element_force
   int component = 0;               // element_force: 0..5 = fx, fy, fz, mx, my, mz
   std::vector<int> beams;          // max_stress: beam indices considered (all when empty)
+  // mass: the bodies (indices) and elements (beam and rail indices) counted; all when `subset` is
+  // false
+  bool subset = false;
+  std::vector<int> mass_bodies, mass_beams, mass_rails;
+  std::string expression;   // expression: the formula
+  std::vector<int> inputs;  // expression: the responses it reads (indices)
   Where where;
 };
 
@@ -86,6 +93,7 @@ struct Study {
   Model model;
   std::vector<AnalysisSpec> analyses;
   std::vector<ResponseSpec> responses;
+  std::vector<int> expression_order;  // the expression responses, each after those it reads
   std::optional<DesignStudy> design;  // without it the analyses run once
   // What in the study file looks mistyped but may be meant ("file:/pointer: message"): printed
   // by `check` and `run`, and listed among the warnings of summary.json.

@@ -1,0 +1,26 @@
+// Derived responses: {"quantity": "expression", "expression": "max(abs(dy), abs(dz))"} computes a
+// formula over the study's other responses, named as variables, with muparser (its functions:
+// abs, sqrt, exp, ln, log10, sin .. atan2, min, max, sum, avg, sign, rint; operators + - * / ^,
+// comparisons and ?:).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/scene/json_reader.hpp"
+
+namespace beamrail {
+
+struct Study;
+
+// Checks every expression response: its syntax, that it names only other responses, and that no
+// expression reads itself through others. Sets each one's inputs and study.expression_order.
+void resolve_expressions(Study& study, Diagnostics& diag);
+
+// Computes the expression responses from the others in `values` (one per study.responses, in
+// place). An input that is NaN (not computed) gives NaN. Returns a warning for each expression
+// that is not finite although its inputs are (a square root of a negative number, a division by
+// zero).
+std::vector<std::string> evaluate_expressions(const Study& study, std::vector<double>& values);
+
+}  // namespace beamrail

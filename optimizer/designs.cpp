@@ -11,6 +11,19 @@ DesignEvaluator::DesignEvaluator(const Study& study) : study_(study), base_(stud
   base_.erase("study");
   for (const DesignVariable& v : study.design->variables)
     pointers_.emplace_back(v.pointers.begin(), v.pointers.end());
+  bool tracked = false;
+  for (const ResponseSpec& r : study.responses) tracked = tracked || r.track;
+  if (!tracked) return;
+  EvaluationOptions options;
+  options.structure_cache = structures_.get();
+  const Evaluation ev = beamrail::evaluate(study, study.model, options);
+  if (ev.status == "ok")
+    references_ = ev.tracked_shapes;
+  else
+    setup_failure_ =
+        "the study's own design, whose mode shapes the tracked frequency responses follow, "
+        "did not evaluate: " +
+        ev.status + ": " + ev.message;
 }
 
 Json DesignEvaluator::document(const std::vector<double>& x) const {
@@ -40,6 +53,7 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x) const {
       EvaluationOptions options;
       options.max_seconds = study_.design->max_seconds_per_design;
       options.structure_cache = structures_.get();
+      if (!references_.empty()) options.mode_references = &references_;
       const Evaluation ev = beamrail::evaluate(*design, design->model, options);
       out.status = ev.status;
       out.message = ev.message;

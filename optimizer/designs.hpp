@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/analysis/sparse_structure.hpp"
+#include "optimizer/responses.hpp"
 #include "optimizer/study.hpp"
 
 namespace beamrail {
@@ -24,7 +25,13 @@ struct DesignOutcome {
 
 class DesignEvaluator {
  public:
+  // Evaluates the study's own design first when a frequency response tracks its mode by shape:
+  // its shapes are the references.
   explicit DesignEvaluator(const Study& study);
+
+  // Why the study's own design, whose mode shapes tracked responses follow, could not be
+  // evaluated ("" when it could, or nothing is tracked): the study cannot run.
+  const std::string& setup_failure() const { return setup_failure_; }
 
   // Thread-safe: reads only the evaluator's constant state.
   DesignOutcome evaluate(const std::vector<double>& x) const;
@@ -43,6 +50,8 @@ class DesignEvaluator {
   Json base_;                                              // study.document without "study"
   std::vector<std::vector<Json::json_pointer>> pointers_;  // per variable
   std::shared_ptr<SparseStructureCache> structures_ = std::make_shared<SparseStructureCache>();
+  ModeShapes references_;  // of tracked frequency responses
+  std::string setup_failure_;
 };
 
 }  // namespace beamrail

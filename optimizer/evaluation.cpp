@@ -149,6 +149,8 @@ class Runner {
       options.time = e.time;
     }
     options.max_seconds = budget_left(options.max_seconds);
+    for (const ResponseSpec& response : study_.responses)
+      options.keep_mass = options.keep_mass || (response.analysis == index && response.track);
     const ModalResult r = solve_modal(model, options, data);
     report.ok = r.ok;
     report.timed_out = r.timed_out;
@@ -163,7 +165,10 @@ class Runner {
     report.nonsymmetric = r.nonsymmetric;
     add_warnings(r.warnings);
     if (!r.ok) return;
-    modal_responses(study_, index, r, ev_.responses);
+    std::vector<std::string> warnings;
+    modal_responses(study_, index, model, r, options_.mode_references, ev_.responses, warnings,
+                    &ev_.tracked_shapes);
+    add_warnings(warnings);
     if (!writes_tables()) return;
     const std::string prefix = table_prefix(spec);
     std::string error;

@@ -10,6 +10,7 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
+#include "optimizer/responses.hpp"
 #include "optimizer/study.hpp"
 
 namespace beamrail {
@@ -68,6 +69,7 @@ struct Evaluation {
   std::vector<AnalysisReport> analyses;
   std::vector<std::string> warnings;
   double wall_seconds = 0.0;
+  ModeShapes tracked_shapes;  // the shapes of the modes tracked frequency responses read
 };
 
 struct EvaluationOptions {
@@ -78,6 +80,9 @@ struct EvaluationOptions {
   // Sparse Jacobian structures shared with other evaluations of the same topology (thread-safe);
   // nullptr: the evaluation's runs share one among themselves only.
   SparseStructureCache* structure_cache = nullptr;
+  // The reference shapes of tracked frequency responses (the study's own design); nullptr: they
+  // read their mode by number.
+  const ModeShapes* mode_references = nullptr;
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed

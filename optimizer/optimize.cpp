@@ -492,6 +492,8 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
 
 int Optimization::run() {
   const auto wall_start = std::chrono::steady_clock::now();
+  if (!evaluator_.setup_failure().empty())
+    return fail_before_designs(study_, settings_.output, "optimize", evaluator_.setup_failure());
   CsvRow header{"start", "evaluation"};
   for (const DesignVariable& v : variables_) header.push_back(v.name);
   for (const ResponseSpec& r : study_.responses) header.push_back(r.name);

@@ -12,6 +12,7 @@ const std::vector<std::string> kResponseQuantities = {
 namespace {
 
 const std::vector<std::string> kComponents = {"fx", "fy", "fz", "mx", "my", "mz"};
+const std::vector<std::string> kDirections = {"x", "y", "z", "rx", "ry", "rz"};
 
 // Whether the study's list of analyses certainly has none of this type. A missing or malformed
 // list, or an entry whose type is missing or wrong, was reported already: then a response that
@@ -198,7 +199,7 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
   const auto q = r.choice("quantity", true, kResponseQuantities);
   if (!q) {
     r.allow({"body", "point", "direction", "axis", "mode", "element", "component", "end",
-             "elements", "analysis", "bodies", "expression"});
+             "elements", "analysis", "bodies", "expression", "track", "dominant"});
     return std::nullopt;
   }
   if (*q == "mass") {
@@ -222,6 +223,24 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
         frequency ? ResponseSpec::Quantity::kFrequency : ResponseSpec::Quantity::kBucklingFactor;
     const auto analysis = analysis_for(
         r, study, frequency ? AnalysisSpec::Type::kModal : AnalysisSpec::Type::kBuckling, *q);
+    if (frequency) {
+      if (const auto track = r.boolean("track", false)) s.track = *track;
+      if (const auto d = r.choice("dominant", false, kDirections)) {
+        s.dominant = static_cast<int>(std::find(kDirections.begin(), kDirections.end(), *d) -
+                                      kDirections.begin());
+        if (r.member("mode", false)) {
+          r.error("dominant", "give either \"mode\" or \"dominant\"");
+          return std::nullopt;
+        }
+        if (s.track) {
+          r.error("track", "a mode chosen by its dominant direction is not tracked by shape");
+          return std::nullopt;
+        }
+        if (!analysis) return std::nullopt;
+        s.analysis = *analysis;
+        return s;
+      }
+    }
     const auto mode = r.integer("mode", true, 1);
     if (!mode || !analysis) return std::nullopt;
     s.analysis = *analysis;

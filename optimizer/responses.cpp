@@ -1,6 +1,7 @@
 #include "optimizer/responses.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "core/model/element_forces.hpp"
@@ -76,13 +77,71 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
   }
 }
 
-void modal_responses(const Study& study, int analysis, const ModalResult& result,
-                     std::vector<double>& values) {
+namespace {
+
+constexpr const char* kDirectionNames[] = {"x", "y", "z", "rx", "ry", "rz"};
+
+ShapeByBody shape_by_body(const Model& model, const Eigen::VectorXd& shape) {
+  ShapeByBody out;
+  for (int k = 0; k < model.n_free(); ++k)
+    out[model.bodies[model.free_bodies[k]].name] = shape.segment<6>(kDofsPerBody * k);
+  return out;
+}
+
+// The reference shape in this model's layout (bodies it lacks stay 0).
+Eigen::VectorXd in_layout(const Model& model, const ShapeByBody& shape) {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(model.n_dofs);
+  for (int k = 0; k < model.n_free(); ++k) {
+    const auto it = shape.find(model.bodies[model.free_bodies[k]].name);
+    if (it != shape.end()) x.segment<6>(kDofsPerBody * k) = it->second;
+  }
+  return x;
+}
+
+}  // namespace
+
+void modal_responses(const Study& study, int analysis, const Model& model,
+                     const ModalResult& result, const ModeShapes* references,
+                     std::vector<double>& values, std::vector<std::string>& warnings,
+                     ModeShapes* selected) {
   for (size_t k = 0; k < study.responses.size(); ++k) {
     const ResponseSpec& r = study.responses[k];
     if (r.analysis != analysis || r.quantity != ResponseSpec::Quantity::kFrequency) continue;
-    const Mode* mode = elastic_mode(result, r.mode);
+    const Mode* mode = nullptr;
+    if (r.dominant >= 0) {
+      for (const Mode& m : result.modes)
+        if (m.kind != Mode::Kind::kRigid && dominant_direction(m, result) == r.dominant) {
+          mode = &m;
+          break;
+        }
+      if (!mode)
+        warnings.push_back("frequency response \"" + r.name + "\": none of the " +
+                           std::to_string(result.modes.size() - result.rigid_modes) +
+                           " elastic modes computed has its dominant direction " +
+                           kDirectionNames[r.dominant] + ": compute more modes");
+    } else if (r.track && references && references->count(static_cast<int>(k)) &&
+               result.mass.rows() == model.n_dofs) {
+      const Eigen::VectorXd reference = in_layout(model, references->at(static_cast<int>(k)));
+      double best = -1.0;
+      for (const Mode& m : result.modes) {
+        if (m.kind == Mode::Kind::kRigid) continue;
+        const double mac = modal_assurance(reference, m.shape, result.mass);
+        if (mac > best) best = mac, mode = &m;
+      }
+      if (mode && best < kTrackedModeMac) {
+        char text[64];
+        std::snprintf(text, sizeof text, "%.3f", best);
+        warnings.push_back("frequency response \"" + r.name + "\" tracks mode " +
+                           std::to_string(r.mode) +
+                           " of the study's design, but no computed mode resembles it (best MAC " +
+                           text + "): its shape has changed character");
+      }
+    } else {
+      mode = elastic_mode(result, r.mode);
+    }
     values[k] = mode ? mode->frequency_hz : std::numeric_limits<double>::quiet_NaN();
+    if (r.track && selected && mode)
+      (*selected)[static_cast<int>(k)] = shape_by_body(model, mode->shape);
   }
 }
 

@@ -1,6 +1,8 @@
 // Computing the study's named responses from analysis results.
 #pragma once
 
+#include <map>
+#include <string>
 #include <vector>
 
 #include "core/analysis/modal_analysis.hpp"
@@ -33,9 +35,24 @@ class PointTracker {
 void static_responses(const Study& study, int analysis, const Model& model, const Data& data,
                       std::vector<double>& values);
 
-// Fills the frequency responses of modal analysis `analysis`.
-void modal_responses(const Study& study, int analysis, const ModalResult& result,
-                     std::vector<double>& values);
+// A mode shape by body name (dc, dtheta of each free body): comparable between designs whose
+// bodies are numbered differently.
+using ShapeByBody = std::map<std::string, Vec6>;
+// Per frequency response (index into study.responses), the shape of the mode it reads.
+using ModeShapes = std::map<int, ShapeByBody>;
+
+// Fills the frequency responses of modal analysis `analysis` (of `model`): by mode number, by
+// dominant direction, or, for a tracked response with a reference shape in `references`, the mode
+// whose shape has the largest MAC against it. Warns (into `warnings`) of a dominant direction no
+// computed mode has and of a tracked mode that resembles its reference poorly (MAC below
+// kTrackedModeMac). The shapes of the modes tracked responses read go to `selected` (when given).
+void modal_responses(const Study& study, int analysis, const Model& model,
+                     const ModalResult& result, const ModeShapes* references,
+                     std::vector<double>& values, std::vector<std::string>& warnings,
+                     ModeShapes* selected);
+
+// Below this MAC against its reference a tracked mode is reported with a warning.
+inline constexpr double kTrackedModeMac = 0.5;
 
 // Fills the buckling_factor responses of buckling analysis `analysis` (+infinity for a mode the
 // loads do not buckle).

@@ -67,8 +67,14 @@ struct ResponseSpec {
   };
   std::string name;
   Quantity quantity = Quantity::kMass;
-  int analysis = -1;               // index of the analysis that produces it (-1: none, mass)
-  int mode = 1;                    // frequency, buckling_factor: 1-based mode
+  int analysis = -1;  // index of the analysis that produces it (-1: none, mass)
+  int mode = 1;       // frequency, buckling_factor: 1-based mode
+  // frequency: follow the mode by its shape, the mode with the largest MAC against mode `mode` of
+  // the study's own design (in a design study), instead of by its number
+  bool track = false;
+  // frequency: the lowest elastic mode whose dominant direction (largest effective mass fraction:
+  // 0..5 = x, y, z, rx, ry, rz) is this one, instead of mode `mode`; -1: by number
+  int dominant = -1;
   int body = 0;                    // displacement-like quantities: body index
   Vec3 point = Vec3::Zero();       // global point in the initial configuration [m]
   Vec3 direction = Vec3::UnitX();  // unit vector, global (the axis of a rotation)

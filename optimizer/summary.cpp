@@ -1,7 +1,9 @@
 #include "optimizer/summary.hpp"
 
 #include <cmath>
+#include <iostream>
 
+#include "optimizer/tables.hpp"
 #include "optimizer/version.hpp"
 
 namespace beamrail {
@@ -9,6 +11,22 @@ namespace beamrail {
 nlohmann::json json_number(double x) {
   if (!std::isfinite(x)) return nullptr;
   return x;
+}
+
+int fail_before_designs(const Study& study, const std::filesystem::path& output,
+                        const std::string& type, const std::string& message) {
+  const nlohmann::json s{{"study", study.name},
+                         {"file", study.file},
+                         {"beamrail_version", kVersion},
+                         {"type", type},
+                         {"status", "failed"},
+                         {"message", message},
+                         {"warnings", study.input_warnings}};
+  std::string error;
+  if (!write_file_atomically(output / "summary.json", s.dump(2) + "\n", &error))
+    std::cerr << "beamrail: " << error << "\n";
+  std::cerr << "beamrail: " << study.name << " failed: " << message << "\n";
+  return 1;
 }
 
 nlohmann::json model_summary(const Model& model) {

@@ -2,7 +2,9 @@
 // responses, the status and the warnings of a run.
 #pragma once
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "optimizer/evaluation.hpp"
 #include "optimizer/study.hpp"
@@ -17,5 +19,10 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
 
 // A number for JSON output: null when not finite.
 nlohmann::json json_number(double x);
+
+// Writes the summary of a batch that failed before its first design (`type`: "sweep",
+// "optimize"); prints the message and returns exit status 1.
+int fail_before_designs(const Study& study, const std::filesystem::path& output,
+                        const std::string& type, const std::string& message);
 
 }  // namespace beamrail

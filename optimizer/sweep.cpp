@@ -23,6 +23,8 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   const DesignStudy& plan = *study.design;
   const std::vector<Design> designs = sweep_designs(plan);
   const DesignEvaluator evaluator(study);
+  if (!evaluator.setup_failure().empty())
+    return fail_before_designs(study, settings.output, "sweep", evaluator.setup_failure());
 
   CsvRow header{"index"};
   for (const DesignVariable& v : plan.variables) header.push_back(v.name);

@@ -244,6 +244,24 @@ int classify(const Eigenpairs& pairs, const SparseMatrix& m, const ElementDeform
   return others;
 }
 
+// The rigid motions r_d (columns: translations along, rotations about the global axes through
+// the origin), the modes' participations x^T M r_d and the totals r_d^T M r_d.
+void participations(const Model& model, const Data& data, const SparseMatrix& m,
+                    ModalResult& result) {
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(model.n_dofs, 6);
+  for (int k = 0; k < model.n_free(); ++k) {
+    const Vec3 c = centre(model, data, model.free_bodies[k]);
+    for (int d = 0; d < 3; ++d) {
+      r(kDofsPerBody * k + d, d) = 1.0;
+      r.block<3, 1>(kDofsPerBody * k, 3 + d) = Vec3::Unit(d).cross(c);
+      r(kDofsPerBody * k + 3 + d, 3 + d) = 1.0;
+    }
+  }
+  const Eigen::MatrixXd mr = m * r;
+  result.rigid_mass = (r.transpose() * mr).diagonal();
+  for (Mode& mode : result.modes) mode.participation = (mode.shape.transpose() * mr).transpose();
+}
+
 }  // namespace
 
 bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& md,
@@ -327,6 +345,28 @@ bool nonsymmetric_eigenvalues_near(const Eigen::SparseMatrix<double>& k,
   }
 }
 
+Vec6 effective_mass_fraction(const Mode& mode, const ModalResult& result) {
+  Vec6 f = Vec6::Zero();
+  for (int d = 0; d < 6; ++d)
+    if (result.rigid_mass(d) > 0.0)
+      f(d) = mode.participation(d) * mode.participation(d) / result.rigid_mass(d);
+  return f;
+}
+
+int dominant_direction(const Mode& mode, const ModalResult& result) {
+  const Vec6 f = effective_mass_fraction(mode, result);
+  int best = -1;
+  for (int d = 0; d < 6; ++d)
+    if (f(d) > 1e-12 && (best < 0 || f(d) > f(best))) best = d;
+  return best;
+}
+
+double modal_assurance(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                       const Eigen::SparseMatrix<double>& m) {
+  const double ab = a.dot(m * b), aa = a.dot(m * a), bb = b.dot(m * b);
+  return aa > 0.0 && bb > 0.0 ? ab * ab / (aa * bb) : 0.0;
+}
+
 const Mode* elastic_mode(const ModalResult& result, int k) {
   int count = 0;
   for (const Mode& mode : result.modes)
@@ -403,6 +443,8 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
           "), vibrations that grow: the torques of fixed direction feed them energy");
     }
     result.ok = true;
+    participations(model, data, m, result);
+    if (options.keep_mass) result.mass = m;
     // Resolution of each non-rigid mode against the rounding of the stiffness terms.
     const auto abs_times = [&sym](const Eigen::VectorXd& x) {
       Eigen::VectorXd out = Eigen::VectorXd::Zero(x.size());

@@ -163,6 +163,8 @@ class Runner {
     report.modes = static_cast<int>(r.modes.size()) - r.rigid_modes;
     report.asymmetry = r.asymmetry;
     report.nonsymmetric = r.nonsymmetric;
+    for (const Mode& mode : r.modes)
+      report.effective_mass_captured += effective_mass_fraction(mode, r);
     add_warnings(r.warnings);
     if (!r.ok) return;
     std::vector<std::string> warnings;

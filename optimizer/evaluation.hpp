@@ -57,6 +57,9 @@ struct AnalysisReport {
   double noise = 0.0;  // largest Mode::noise among the modes found
   double asymmetry = 0.0;
   bool nonsymmetric = false;  // the non-symmetric eigenproblem (torques of fixed direction)
+  // per direction x .. rz: the effective mass of the modes computed (rigid ones included) over
+  // the total; near 1 when the modes computed capture the scene's response to a base motion
+  Vec6 effective_mass_captured = Vec6::Zero();
   // buckling (eigensolver above)
   std::vector<double> factors;  // the lowest positive load factors, ascending
   int positive_factors = 0;     // found in all (fewer than asked: the others are infinite)

@@ -1,6 +1,8 @@
 // Reading the named "responses" of a study.
 #include <algorithm>
+#include <iterator>
 
+#include "core/analysis/modal_analysis.hpp"
 #include "optimizer/study.hpp"
 
 namespace beamrail {
@@ -12,7 +14,7 @@ const std::vector<std::string> kResponseQuantities = {
 namespace {
 
 const std::vector<std::string> kComponents = {"fx", "fy", "fz", "mx", "my", "mz"};
-const std::vector<std::string> kDirections = {"x", "y", "z", "rx", "ry", "rz"};
+const std::vector<std::string> kDirections(std::begin(kDirectionNames), std::end(kDirectionNames));
 
 // Whether the study's list of analyses certainly has none of this type. A missing or malformed
 // list, or an entry whose type is missing or wrong, was reported already: then a response that

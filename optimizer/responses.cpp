@@ -79,8 +79,6 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
 
 namespace {
 
-constexpr const char* kDirectionNames[] = {"x", "y", "z", "rx", "ry", "rz"};
-
 ShapeByBody shape_by_body(const Model& model, const Eigen::VectorXd& shape) {
   ShapeByBody out;
   for (int k = 0; k < model.n_free(); ++k)

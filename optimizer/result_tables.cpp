@@ -75,9 +75,11 @@ bool write_static_tables(const std::filesystem::path& directory, const std::stri
 
 bool write_modal_tables(const std::filesystem::path& directory, const std::string& prefix,
                         const Model& model, const ModalResult& result, std::string* error) {
+  std::vector<std::string> header{"mode", "frequency_hz", "kind", "dominant"};
+  for (const char* column : {"participation_", "effective_mass_", "effective_mass_fraction_"})
+    for (const char* d : kDirectionNames) header.push_back(std::string(column) + d);
   CsvWriter modes, shapes;
-  if (!modes.open(directory / (prefix + "modes.csv"), {"mode", "frequency_hz", "kind"}, error,
-                  true) ||
+  if (!modes.open(directory / (prefix + "modes.csv"), header, error, true) ||
       !shapes.open(directory / (prefix + "mode_shapes.csv"),
                    {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
     return false;
@@ -87,12 +89,21 @@ bool write_modal_tables(const std::filesystem::path& directory, const std::strin
                        : mode.kind == Mode::Kind::kUnstable ? "unstable"
                                                             : "elastic";
     const int number = mode.kind == Mode::Kind::kRigid ? 0 : ++elastic;
-    modes.row({std::to_string(number), format_number(mode.frequency_hz), kind});
+    const int dominant = dominant_direction(mode, result);
+    std::vector<std::string> row{std::to_string(number), format_number(mode.frequency_hz), kind,
+                                 dominant >= 0 ? kDirectionNames[dominant] : "none"};
+    const Vec6 fraction = effective_mass_fraction(mode, result);
+    for (int d = 0; d < 6; ++d) row.push_back(format_number(mode.participation(d)));
+    for (int d = 0; d < 6; ++d)
+      row.push_back(format_number(mode.participation(d) * mode.participation(d)));
+    for (int d = 0; d < 6; ++d) row.push_back(format_number(fraction(d)));
+    modes.row(row);
     if (mode.kind == Mode::Kind::kRigid) continue;
     for (int k = 0; k < model.n_free(); ++k) {
-      std::vector<std::string> row{std::to_string(number), model.bodies[model.free_bodies[k]].name};
-      for (int c = 0; c < 6; ++c) row.push_back(format_number(mode.shape(6 * k + c)));
-      shapes.row(row);
+      std::vector<std::string> shape_row{std::to_string(number),
+                                         model.bodies[model.free_bodies[k]].name};
+      for (int c = 0; c < 6; ++c) shape_row.push_back(format_number(mode.shape(6 * k + c)));
+      shapes.row(shape_row);
     }
   }
   return modes.commit(error) && shapes.commit(error);

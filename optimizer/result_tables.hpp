@@ -48,8 +48,9 @@ inline constexpr std::chrono::seconds kTimeseriesFlushInterval{1};
 bool write_static_tables(const std::filesystem::path& directory, const std::string& prefix,
                          const Model& model, const Data& data, std::string* error);
 
-// modes.csv (mode, frequency_hz, kind; rigid-body modes first with mode 0) and mode_shapes.csv
-// (elastic modes, M-normalized, per free body).
+// modes.csv (mode, frequency_hz, kind; rigid-body modes first with mode 0; the dominant direction,
+// then per direction x .. rz the participation, effective mass and its fraction of the total, see
+// Mode::participation) and mode_shapes.csv (elastic modes, M-normalized, per free body).
 bool write_modal_tables(const std::filesystem::path& directory, const std::string& prefix,
                         const Model& model, const ModalResult& result, std::string* error);
 

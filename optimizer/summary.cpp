@@ -123,6 +123,9 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["largest_noise"] = json_number(a.noise);
       j["stiffness_asymmetry"] = json_number(a.asymmetry);
       j["eigenproblem"] = a.nonsymmetric ? "non-symmetric" : "symmetric";
+      nlohmann::json captured = nlohmann::json::object();
+      for (int d = 0; d < 6; ++d) captured[kDirectionNames[d]] = a.effective_mass_captured(d);
+      j["effective_mass_captured"] = captured;
     }
     if (a.type == "buckling") {
       j["eigensolver"] = a.eigensolver;

@@ -244,13 +244,22 @@ int classify(const Eigenpairs& pairs, const SparseMatrix& m, const ElementDeform
   return others;
 }
 
-// The rigid motions r_d (columns: translations along, rotations about the global axes through
-// the origin), the modes' participations x^T M r_d and the totals r_d^T M r_d.
+// The rigid motions r_d (columns: translations along the global axes, rotations about the global
+// axes through the free bodies' centre of mass), the modes' participations x^T M r_d and the
+// totals r_d^T M r_d.
 void participations(const Model& model, const Data& data, const SparseMatrix& m,
                     ModalResult& result) {
+  double total = 0.0;
+  Vec3 weighted = Vec3::Zero();
+  for (int k = 0; k < model.n_free(); ++k) {
+    const double mass = model.bodies[model.free_bodies[k]].mass;
+    total += mass;
+    weighted += mass * centre(model, data, model.free_bodies[k]);
+  }
+  result.reference_point = total > 0.0 ? Vec3(weighted / total) : Vec3::Zero();
   Eigen::MatrixXd r = Eigen::MatrixXd::Zero(model.n_dofs, 6);
   for (int k = 0; k < model.n_free(); ++k) {
-    const Vec3 c = centre(model, data, model.free_bodies[k]);
+    const Vec3 c = centre(model, data, model.free_bodies[k]) - result.reference_point;
     for (int d = 0; d < 3; ++d) {
       r(kDofsPerBody * k + d, d) = 1.0;
       r.block<3, 1>(kDofsPerBody * k, 3 + d) = Vec3::Unit(d).cross(c);
@@ -487,10 +496,14 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
                        std::to_string(result.rigid_modes) +
                        " rigid-body or mechanism mode(s), which deform no element";
     }
+    // A rigid mode's eigenvalue is 0 up to the rounding of the stiffness, ~eps lambda_max (a
+    // floating pair of bodies off the axes: -4e-9 1/s^2 beside lambda_max = 1.7e7); the shift is
+    // 1e4 eps times the stiffness scale, so a tenth of it stays clear of that rounding while an
+    // inverted pendulum's -g/l is far below it.
     int unstable = 0;
     for (const Mode& mode : result.modes)
       unstable += mode.eigenvalue < 0.0 &&
-                  (mode.kind != Mode::Kind::kRigid || mode.eigenvalue < -1e-6 * result.shift);
+                  (mode.kind != Mode::Kind::kRigid || mode.eigenvalue < -0.1 * result.shift);
     if (unstable > 0 && result.ok) {
       result.ok = false;
       result.message =

@@ -60,8 +60,9 @@ struct Mode {
   Eigen::VectorXd shape;  // M-normalized (x^T M x = 1), dim n_dofs; largest entry positive
   // Participation in rigid motions of the whole scene: gamma_d = x^T M r_d for unit translations
   // along global x, y, z (r_d: every centre moves by e_d) and unit rotations about the global x,
-  // y, z axes through the origin (r_d: centres move by e_d x c, bodies turn by e_d). The effective
-  // modal mass is gamma_d^2 [kg, kg m^2]; over all modes it sums to ModalResult::rigid_mass.
+  // y, z axes through ModalResult::reference_point (r_d: centres move by e_d x (c - p), bodies
+  // turn by e_d) [sqrt(kg), sqrt(kg) m]. The effective modal mass is gamma_d^2 [kg, kg m^2]; over
+  // all modes (rigid ones included) it sums to ModalResult::rigid_mass.
   Vec6 participation = Vec6::Zero();
 };
 
@@ -79,14 +80,20 @@ struct ModalResult {
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
   // r_d^T M r_d of the rigid motions of Mode::participation: the free bodies' total mass for
-  // translations, their inertia about the global axes through the origin for rotations.
+  // translations, their inertia about the global axes through reference_point for rotations.
   Vec6 rigid_mass = Vec6::Zero();
+  // The free bodies' centre of mass in the configuration linearized about: the rotations'
+  // reference, so that no translation is counted as a rotation about a distant origin [m].
+  Vec3 reference_point = Vec3::Zero();
   Eigen::SparseMatrix<double> mass;  // M at the configuration, when ModalOptions::keep_mass
 };
 
 // The effective modal mass of each rigid motion over its total, gamma_d^2 / (r_d^T M r_d) (0 where
 // the total is 0).
 Vec6 effective_mass_fraction(const Mode& mode, const ModalResult& result);
+
+// The names of the rigid motions of Mode::participation, in order.
+inline constexpr const char* kDirectionNames[6] = {"x", "y", "z", "rx", "ry", "rz"};
 
 // The direction (0..5: x, y, z, rx, ry, rz) with the largest effective mass fraction, or -1 when
 // the mode moves the scene's mass in no rigid direction.

@@ -12,6 +12,7 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
+#include "tests/support/closed_forms.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace beamrail {
@@ -25,16 +26,7 @@ std::string num(double x) {
   return buf;
 }
 
-// Angular frequencies^2 of the 2 x 2 bending problem of a tip body whose centre of mass lies e
-// beyond the tip: K = EI [12/l^3, s 6/l^2; s 6/l^2, 4/l], M = [m, m e; m e, J + m e^2] (s = -1
-// for bending in y about z, +1 for bending in z about y; the sign does not change the result).
-std::array<double, 2> bending_pair(double ei, double l, double m, double j, double e) {
-  Eigen::Matrix2d k, mm;
-  k << 12 * ei / (l * l * l), -6 * ei / (l * l), -6 * ei / (l * l), 4 * ei / l;
-  mm << m, m * e, m * e, j + m * e * e;
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> eig(k, mm);
-  return {eig.eigenvalues()(0), eig.eigenvalues()(1)};
-}
+using testing::bending_pair;
 
 TEST(Modal, TipBodyWithRotaryInertiaAndOffsetMatchesTheTwoByTwoClosedForm) {
   const double e_mod = 2.1e11, g_mod = 8.0769e10, l = 0.9, w = 0.01, h = 0.014;

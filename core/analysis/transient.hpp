@@ -17,7 +17,7 @@ namespace beamrail {
 enum class JacobianKind { kExact, kFiniteDifference };
 enum class LinearSolverKind { kAuto, kDense, kSparse };
 
-// Defaults of the integrator families (measured: see README "Speed and accuracy").
+// Defaults of the integrator families (measured: see README "Speed and accuracy, measured").
 inline constexpr const char* kDefaultDirkTable = "ARK548L2SA_DIRK_8_4_5";
 inline constexpr const char* kDefaultErkTable = "DORMAND_PRINCE_7_4_5";
 // linear_solver "auto": dense below this many states, sparse (KLU) from it. Measured on the

@@ -106,6 +106,22 @@ std::optional<DesignVariable> read_variable(const Json& value, const Where& wher
   }
   const bool grid = type == DesignStudy::Type::kSweep && sampling == SweepPlan::Sampling::kGrid;
   const bool list = type == DesignStudy::Type::kSweep && sampling == SweepPlan::Sampling::kList;
+  if (type == DesignStudy::Type::kSensitivity) {
+    // The value the study gives: the number at the first pointer, through its link.
+    if (!ok) return std::nullopt;
+    const Json* at = nullptr;
+    try {
+      at = &study.document.at(Json::json_pointer(v.pointers[0]));
+    } catch (const std::exception&) {
+    }
+    if (!at || !at->is_number() || v.factors[0] == 0.0) {
+      r.error("pointer", "a sensitivity needs a number at the first pointer and a non-zero factor");
+      return std::nullopt;
+    }
+    v.value = (at->get<double>() - v.offsets[0]) / v.factors[0];
+    v.name = *name;
+    return v;
+  }
   if (grid && r.member("values", false)) {
     const auto values = r.numbers("values", true, -1);
     if (!values) return std::nullopt;
@@ -322,7 +338,8 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
   {
     ObjectReader r(value, where, diag);
     if (!r.is_object()) return std::nullopt;
-    const auto type = r.choice("type", true, {"sweep", "optimize", "work_precision"});
+    const auto type =
+        r.choice("type", true, {"sweep", "optimize", "work_precision", "sensitivity"});
     if (!type) {
       r.allow({"variables",
                "sampling",
@@ -345,6 +362,8 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
                "reference",
                "target_error",
                "warned_designs",
+               "check",
+               "check_step",
                "max_seconds_per_design"});
       return std::nullopt;
     }
@@ -353,7 +372,9 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
       read_work_precision(r, study, d);
       return diag.size() > errors_before ? std::nullopt : std::optional<DesignStudy>(d);
     }
-    d.type = *type == "sweep" ? DesignStudy::Type::kSweep : DesignStudy::Type::kOptimize;
+    d.type = *type == "sweep"         ? DesignStudy::Type::kSweep
+             : *type == "sensitivity" ? DesignStudy::Type::kSensitivity
+                                      : DesignStudy::Type::kOptimize;
     if (d.type == DesignStudy::Type::kSweep) {
       const auto s = r.choice("sampling", false, {"grid", "list", "lhs"});
       if (s)
@@ -378,10 +399,14 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
       }
     }
     d.max_seconds_per_design = r.positive("max_seconds_per_design", false).value_or(0.0);
-    if (d.type == DesignStudy::Type::kSweep)
+    if (d.type == DesignStudy::Type::kSweep) {
       read_sweep(r, study, d);
-    else
+    } else if (d.type == DesignStudy::Type::kSensitivity) {
+      d.sensitivity.check = r.boolean("check", false).value_or(false);
+      d.sensitivity.check_step = r.positive("check_step", false).value_or(d.sensitivity.check_step);
+    } else {
       read_optimize(r, study, d);
+    }
     // NLopt refuses some combinations (a missing algorithm, constraints an algorithm cannot take
     // inside a wrapper) only when it runs: find out now instead of after the first evaluations.
     if (d.type == DesignStudy::Type::kOptimize && diag.size() == errors_before) {

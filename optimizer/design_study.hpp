@@ -21,6 +21,7 @@ struct DesignVariable {
   double lower = 0.0, upper = 0.0;
   int count = 0;                  // sweep/grid: lower..upper in count steps (when values is empty)
   std::optional<double> initial;  // optimize: first start's value
+  double value = 0.0;             // sensitivity: the value differentiated at
   Where where;
 };
 
@@ -74,13 +75,21 @@ struct WorkPrecisionPlan {
   double target_error = 1e-6;   // the cheapest run meeting it is named in the summary
 };
 
+// The derivatives of every response with respect to every variable at the study's own design
+// (optimizer/sensitivities.hpp); with `check`, beside central differences of the responses.
+struct SensitivityPlan {
+  bool check = false;
+  double check_step = 1e-5;  // relative step of the differences (of |value|, or 1 at 0)
+};
+
 struct DesignStudy {
-  enum class Type { kSweep, kOptimize, kWorkPrecision };
+  enum class Type { kSweep, kOptimize, kWorkPrecision, kSensitivity };
   Type type = Type::kSweep;
   std::vector<DesignVariable> variables;
   SweepPlan sweep;
   OptimizePlan optimize;
   WorkPrecisionPlan work_precision;
+  SensitivityPlan sensitivity;
   // Wall-clock budget of one design's evaluation [s]; 0: none. A design still running when it is
   // spent becomes a "timeout" row.
   double max_seconds_per_design = 0.0;

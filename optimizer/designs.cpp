@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "optimizer/evaluation.hpp"
+#include "optimizer/tables.hpp"
 
 namespace beamrail {
 
@@ -35,7 +36,52 @@ Json DesignEvaluator::document(const std::vector<double>& x) const {
   return doc;
 }
 
-DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x) const {
+namespace {
+
+// The problems of an invalid design on one line.
+std::string problems(const Diagnostics& diag) {
+  std::string out;
+  for (const Diagnostic& d : diag.items()) {
+    if (!out.empty()) out += "; ";
+    out += d.pointer + ": " + d.message;
+  }
+  return out;
+}
+
+}  // namespace
+
+ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& x,
+                                                     const Study& design,
+                                                     const Evaluation& ev) const {
+  const auto& variables = study_.design->variables;
+  std::vector<Study> plus, minus;
+  std::vector<double> h;
+  plus.reserve(variables.size());
+  minus.reserve(variables.size());
+  for (size_t j = 0; j < variables.size(); ++j) {
+    h.push_back(sensitivity_step(x[j], variables[j].upper - variables[j].lower));
+    for (const double sign : {1.0, -1.0}) {
+      std::vector<double> at = x;
+      at[j] += sign * h[j];
+      Diagnostics diag;
+      auto s = load_study(document(at), study_.file, study_.directory, diag);
+      if (!s) {
+        ResponseSensitivities out;
+        out.message = "no derivative with respect to \"" + variables[j].name +
+                      "\": the design a step of " + format_number(h[j]) +
+                      " away is invalid: " + problems(diag);
+        return out;
+      }
+      (sign > 0 ? plus : minus).push_back(std::move(*s));
+    }
+  }
+  std::vector<const Study*> p, m;
+  for (size_t j = 0; j < variables.size(); ++j) p.push_back(&plus[j]), m.push_back(&minus[j]);
+  return response_sensitivities(design, ev, p, m, h);
+}
+
+DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,
+                                        ResponseSensitivities* sensitivities) const {
   const auto start = std::chrono::steady_clock::now();
   DesignOutcome out;
   out.responses.assign(study_.responses.size(), std::numeric_limits<double>::quiet_NaN());
@@ -45,16 +91,22 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x) const {
     if (!design) {
       // The first problem names what the values broke (zero-length beam, point on the axis...).
       out.status = "invalid";
-      for (const Diagnostic& d : diag.items()) {
-        if (!out.message.empty()) out.message += "; ";
-        out.message += d.pointer + ": " + d.message;
-      }
+      out.message = problems(diag);
     } else {
       EvaluationOptions options;
       options.max_seconds = study_.design->max_seconds_per_design;
       options.structure_cache = structures_.get();
       if (!references_.empty()) options.mode_references = &references_;
+      options.keep_states = sensitivities != nullptr;
       const Evaluation ev = beamrail::evaluate(*design, design->model, options);
+      if (sensitivities) {
+        if (ev.status == "ok") {
+          *sensitivities = this->sensitivities(x, *design, ev);
+        } else {
+          *sensitivities = ResponseSensitivities();
+          sensitivities->message = "the design did not evaluate";
+        }
+      }
       out.status = ev.status;
       out.message = ev.message;
       out.responses = ev.responses;

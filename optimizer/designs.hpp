@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "core/analysis/sparse_structure.hpp"
+#include "optimizer/evaluation.hpp"
 #include "optimizer/responses.hpp"
+#include "optimizer/sensitivities.hpp"
 #include "optimizer/study.hpp"
 
 namespace beamrail {
@@ -33,8 +35,12 @@ class DesignEvaluator {
   // evaluated ("" when it could, or nothing is tracked): the study cannot run.
   const std::string& setup_failure() const { return setup_failure_; }
 
-  // Thread-safe: reads only the evaluator's constant state.
-  DesignOutcome evaluate(const std::vector<double>& x) const;
+  // Thread-safe: reads only the evaluator's constant state. With `sensitivities`, also the
+  // derivatives of every response with respect to every variable at x (the designs at x +- h
+  // along each variable are built, not analysed: optimizer/sensitivities.hpp); they are left
+  // !ok with a message when the design did not evaluate or has none.
+  DesignOutcome evaluate(const std::vector<double>& x,
+                         ResponseSensitivities* sensitivities = nullptr) const;
 
   // The study document with the variables set to x and no design study: a study that
   // `beamrail run` runs as is.
@@ -46,6 +52,9 @@ class DesignEvaluator {
   size_t n_variables() const { return study_.design->variables.size(); }
 
  private:
+  ResponseSensitivities sensitivities(const std::vector<double>& x, const Study& design,
+                                      const Evaluation& ev) const;
+
   const Study& study_;
   Json base_;                                              // study.document without "study"
   std::vector<std::vector<Json::json_pointer>> pointers_;  // per variable

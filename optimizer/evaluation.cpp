@@ -23,7 +23,11 @@ class Runner {
  public:
   Runner(const Study& study, const Model& model, const EvaluationOptions& options, Evaluation& ev,
          std::chrono::steady_clock::time_point start)
-      : study_(study), model_(model), options_(options), ev_(ev), start_(start) {}
+      : study_(study), model_(model), options_(options), ev_(ev), start_(start) {
+    states_->analyses.resize(study.analyses.size());
+  }
+
+  std::shared_ptr<const EvaluationStates> states() const { return states_; }
 
   // Runs analysis `index` of the study; false when it failed (the evaluation then stops).
   bool run(int index) {
@@ -59,12 +63,7 @@ class Runner {
   }
 
  private:
-  // A static equilibrium: solved once, shared by the analyses that need it.
-  struct Equilibrium {
-    StaticResult result;
-    std::unique_ptr<Data> data;
-    double time = 0.0;  // the loads' time
-  };
+  using Equilibrium = EvaluationStates::Equilibrium;
 
   // The model with the loads of `load_case` (and those without a case): the study's own when
   // every load applies.
@@ -72,9 +71,9 @@ class Runner {
     bool all = true;
     for (const Load& load : model_.loads) all = all && applies_in_case(load, load_case);
     if (all) return model_;
-    auto it = case_models_.find(load_case);
-    if (it == case_models_.end())
-      it = case_models_.emplace(load_case, model_for_case(model_, load_case)).first;
+    auto it = states_->case_models.find(load_case);
+    if (it == states_->case_models.end())
+      it = states_->case_models.emplace(load_case, model_for_case(model_, load_case)).first;
     return it->second;
   }
 
@@ -87,29 +86,40 @@ class Runner {
     return -1;
   }
 
-  // The equilibrium under the loads of `load_case`: with the options of static analysis
-  // `listed` (or the defaults when -1), at the loads' time `time` (NaN: that of the options).
-  Equilibrium& equilibrium(const std::string& load_case, int listed, double time) {
+  // The key of the equilibrium under the loads of `load_case` with the options of static analysis
+  // `listed` (or the defaults when -1), at the loads' time `time` (NaN: that of the options),
+  // solved once.
+  std::string equilibrium_key(const std::string& load_case, int listed, double time) {
     StaticOptions options = listed >= 0 ? study_.analyses[listed].statics : StaticOptions{};
     if (!std::isnan(time)) options.time = time;
     const std::string key =
         load_case + '\n' + std::to_string(listed) + '\n' + format_number(options.time);
-    auto it = equilibria_.find(key);
-    if (it != equilibria_.end()) return it->second;
-    Equilibrium& e = equilibria_[key];
+    if (states_->equilibria.count(key)) return key;
+    Equilibrium& e = states_->equilibria[key];
     const Model& model = case_model(load_case);
     options.structure_cache = structure_cache();
     options.max_seconds = budget_left(options.max_seconds);
     e.data = std::make_unique<Data>(model);
+    e.model = &model;
+    e.load_case = load_case;
     e.result = solve_static(model, options, *e.data);
     e.time = options.time;
-    return e;
+    return key;
+  }
+
+  Equilibrium& equilibrium(const std::string& load_case, int listed, double time) {
+    return states_->equilibria.at(equilibrium_key(load_case, listed, time));
   }
 
   void run_static(int index, AnalysisReport& report) {
     const AnalysisSpec& spec = study_.analyses[index];
-    const Equilibrium& e = equilibrium(spec.load_case, index, kNaN);
+    const std::string key = equilibrium_key(spec.load_case, index, kNaN);
+    const Equilibrium& e = states_->equilibria.at(key);
     const StaticResult& r = e.result;
+    EvaluationStates::Analysis& state = states_->analyses[index];
+    state.model = e.model;
+    state.equilibrium = key;
+    state.time = e.time;
     report.ok = r.ok;
     report.timed_out = r.timed_out;
     report.message = r.message;
@@ -119,6 +129,7 @@ class Runner {
     add_warnings(r.warnings);
     const Model& model = case_model(spec.load_case);
     static_responses(study_, index, model, *e.data, ev_.responses);
+    state.ok = true;
     if (!writes_tables()) return;
     const std::string prefix = table_prefix(spec);
     std::string error;
@@ -133,11 +144,14 @@ class Runner {
     const AnalysisSpec& spec = study_.analyses[index];
     report.about = spec.about_static ? "static" : "initial";
     const Model& model = case_model(spec.load_case);
-    Data data(model);
+    EvaluationStates::Analysis& state = states_->analyses[index];
+    state.data = std::make_unique<Data>(model);
+    Data& data = *state.data;
     ModalOptions options = spec.modal;
     if (spec.about_static) {
       // The static analysis of this load case listed in the study, or one with default options.
-      const Equilibrium& e = equilibrium(spec.load_case, listed_static(spec.load_case), kNaN);
+      state.equilibrium = equilibrium_key(spec.load_case, listed_static(spec.load_case), kNaN);
+      const Equilibrium& e = states_->equilibria.at(state.equilibrium);
       report.statics = e.result;
       if (!e.result.ok) {
         report.timed_out = e.result.timed_out;
@@ -146,6 +160,7 @@ class Runner {
       }
       data.pose = e.data->pose;
       data.q = e.data->q;
+      data.rotation = e.data->rotation;
       options.time = e.time;
     }
     options.max_seconds = budget_left(options.max_seconds);
@@ -168,9 +183,11 @@ class Runner {
     add_warnings(r.warnings);
     if (!r.ok) return;
     std::vector<std::string> warnings;
+    std::vector<int> chosen;
     modal_responses(study_, index, model, r, options_.mode_references, ev_.responses, warnings,
-                    &ev_.tracked_shapes);
+                    &ev_.tracked_shapes, &chosen);
     add_warnings(warnings);
+    keep_modes(state, model, options, r, chosen);
     if (!writes_tables()) return;
     const std::string prefix = table_prefix(spec);
     std::string error;
@@ -187,18 +204,19 @@ class Runner {
   void run_buckling(int index, AnalysisReport& report) {
     const AnalysisSpec& spec = study_.analyses[index];
     const std::string& c = spec.load_case;
-    const Model unloaded = with_loads(
-        model_, [](const Load&) { return false; }, false);
-    const Model scaled = with_loads(
-        model_,
-        [&](const Load& load) { return c.empty() ? load.load_case.empty() : load.load_case == c; },
-        c.empty());
-    Data data(model_);
+    EvaluationStates::Analysis& state = states_->analyses[index];
+    auto [reference_model, scaled_model] = buckling_models(model_, c);
+    state.reference = std::make_unique<Model>(std::move(reference_model));
+    state.scaled = std::make_unique<Model>(std::move(scaled_model));
+    const Model* reference = state.reference.get();
+    const Model& scaled = *state.scaled;
+    state.data = std::make_unique<Data>(model_);
+    Data& data = *state.data;
     BucklingOptions options = spec.buckling;
-    const Model* reference = &unloaded;
+    state.time = options.time;
     if (!c.empty()) {
-      reference = &case_model("");
-      const Equilibrium& e = equilibrium("", listed_static(""), options.time);
+      state.equilibrium = equilibrium_key("", listed_static(""), options.time);
+      const Equilibrium& e = states_->equilibria.at(state.equilibrium);
       report.statics = e.result;
       if (!e.result.ok) {
         report.timed_out = e.result.timed_out;
@@ -224,6 +242,19 @@ class Runner {
     add_warnings(r.warnings);
     if (!r.ok) return;
     buckling_responses(study_, index, r, ev_.responses);
+    state.ok = true;
+    state.shapes.resize(model_.n_dofs, static_cast<Eigen::Index>(r.modes.size()));
+    for (size_t m = 0; m < r.modes.size(); ++m) {
+      state.eigenvalues.push_back(r.modes[m].factor);
+      state.shapes.col(static_cast<Eigen::Index>(m)) = r.modes[m].shape;
+    }
+    state.response_mode.assign(study_.responses.size(), -1);
+    for (size_t k = 0; k < study_.responses.size(); ++k) {
+      const ResponseSpec& rs = study_.responses[k];
+      if (rs.analysis == index && rs.quantity == ResponseSpec::Quantity::kBucklingFactor &&
+          rs.mode <= static_cast<int>(r.modes.size()))
+        state.response_mode[k] = rs.mode - 1;
+    }
     if (!writes_tables()) return;
     const std::string prefix = table_prefix(spec);
     std::string error;
@@ -316,6 +347,31 @@ class Runner {
     }
   }
 
+  // The elastic modes of a modal result and the mode each frequency response read (chosen: per
+  // response, an index into r.modes or -1).
+  static void keep_modes(EvaluationStates::Analysis& state, const Model& model,
+                         const ModalOptions& options, const ModalResult& r,
+                         const std::vector<int>& chosen) {
+    state.ok = true;
+    state.model = &model;
+    state.time = options.time;
+    state.load_factor = options.load_factor;
+    state.nonsymmetric = r.nonsymmetric;
+    std::vector<int> column(r.modes.size(), -1);
+    int n = 0;
+    for (size_t m = 0; m < r.modes.size(); ++m)
+      if (r.modes[m].kind != Mode::Kind::kRigid) column[m] = n++;
+    state.shapes.resize(model.n_dofs, n);
+    for (size_t m = 0; m < r.modes.size(); ++m)
+      if (column[m] >= 0) {
+        state.eigenvalues.push_back(r.modes[m].eigenvalue);
+        state.shapes.col(column[m]) = r.modes[m].shape;
+      }
+    state.response_mode.assign(chosen.size(), -1);
+    for (size_t k = 0; k < chosen.size(); ++k)
+      if (chosen[k] >= 0) state.response_mode[k] = column[chosen[k]];
+  }
+
   bool writes_tables() const { return !options_.output_directory.empty(); }
 
   static std::string table_prefix(const AnalysisSpec& spec) { return table_file(spec, ""); }
@@ -370,13 +426,25 @@ class Runner {
   const Model& model_;
   const EvaluationOptions& options_;
   Evaluation& ev_;
-  std::map<std::string, Model> case_models_;
-  std::map<std::string, Equilibrium> equilibria_;
+  std::shared_ptr<EvaluationStates> states_ = std::make_shared<EvaluationStates>();
   SparseStructureCache structures_;  // when the caller shares none
   std::chrono::steady_clock::time_point start_;
 };
 
 }  // namespace
+
+std::pair<Model, Model> buckling_models(const Model& model, const std::string& load_case) {
+  Model reference = load_case.empty() ? with_loads(
+                                            model, [](const Load&) { return false; }, false)
+                                      : model_for_case(model, "");
+  Model scaled = with_loads(
+      model,
+      [&](const Load& load) {
+        return load_case.empty() ? load.load_case.empty() : load.load_case == load_case;
+      },
+      load_case.empty());
+  return {std::move(reference), std::move(scaled)};
+}
 
 Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -396,6 +464,7 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
       }
       if (!runner.run(static_cast<int>(i))) break;
     }
+    if (options.keep_states) ev.states = runner.states();
     for (std::string& w : evaluate_expressions(study, ev.responses))
       ev.warnings.push_back(std::move(w));
   } catch (const std::exception& e) {

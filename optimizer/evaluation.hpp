@@ -3,6 +3,8 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,6 +67,41 @@ struct AnalysisReport {
   int positive_factors = 0;     // found in all (fewer than asked: the others are infinite)
 };
 
+// What an evaluation leaves for its design sensitivities (EvaluationOptions::keep_states): the
+// states its analyses reported about, and which mode each response read.
+struct EvaluationStates {
+  struct Equilibrium {
+    StaticResult result;
+    std::unique_ptr<Data> data;
+    const Model* model = nullptr;  // its load case's model
+    std::string load_case;
+    double time = 0.0;  // the loads' time
+  };
+  struct Analysis {
+    bool ok = false;
+    const Model* model = nullptr;  // the analysis's model (its load case)
+    std::string equilibrium;       // key into equilibria; "": a state independent of the design
+    std::unique_ptr<Data> data;    // modal, buckling: the state linearized about
+    double time = 0.0, load_factor = 1.0;
+    // modal: every elastic mode computed (eigenvalues ascending, M-normalized shapes as columns);
+    // buckling: every positive factor computed and its shape
+    std::vector<double> eigenvalues;
+    Eigen::MatrixXd shapes;
+    bool nonsymmetric = false;
+    std::vector<int> response_mode;  // per study response: the column of `shapes` it reads, or -1
+    // buckling: the structure with its constant loads, and with the loads to scale
+    std::unique_ptr<Model> reference, scaled;
+  };
+  std::map<std::string, Model> case_models;
+  std::map<std::string, Equilibrium> equilibria;
+  std::vector<Analysis> analyses;  // one per study analysis
+};
+
+// The structure a buckling analysis of `load_case` holds at its reference (its constant loads:
+// those without a case and gravity; none when the case is "") and the structure with the loads it
+// scales (those of the case; without a case, those without one and gravity).
+std::pair<Model, Model> buckling_models(const Model& model, const std::string& load_case);
+
 struct Evaluation {
   std::string status = "ok";  // ok | failed | timeout | invalid | interrupted
   std::string message;
@@ -73,6 +110,7 @@ struct Evaluation {
   std::vector<std::string> warnings;
   double wall_seconds = 0.0;
   ModeShapes tracked_shapes;  // the shapes of the modes tracked frequency responses read
+  std::shared_ptr<const EvaluationStates> states;  // when EvaluationOptions::keep_states
 };
 
 struct EvaluationOptions {
@@ -86,6 +124,8 @@ struct EvaluationOptions {
   // The reference shapes of tracked frequency responses (the study's own design); nullptr: they
   // read their mode by number.
   const ModeShapes* mode_references = nullptr;
+  // Keep the states the analyses reported about (Evaluation::states), for design sensitivities.
+  bool keep_states = false;
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed

@@ -4,6 +4,7 @@
 // comparisons and ?:).
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -22,5 +23,11 @@ void resolve_expressions(Study& study, Diagnostics& diag);
 // that is not finite although its inputs are (a square root of a negative number, a division by
 // zero).
 std::vector<std::string> evaluate_expressions(const Study& study, std::vector<double>& values);
+
+// The rows of `jacobian` (responses x variables) of the expression responses, by the chain rule
+// from the rows of the responses they read: d e / d r by muparser's numerical derivative at
+// `values` (the responses of the design).
+void chain_expression_derivatives(const Study& study, const std::vector<double>& values,
+                                  Eigen::Ref<Eigen::MatrixXd> jacobian);
 
 }  // namespace beamrail

@@ -100,6 +100,9 @@ bool OutputFolder::start(const Study& study, std::string* error) const {
       case DesignStudy::Type::kWorkPrecision:
         running["type"] = "work_precision";
         break;
+      case DesignStudy::Type::kSensitivity:
+        running["type"] = "sensitivity";
+        break;
     }
   }
   running["status"] = "running";

@@ -101,7 +101,8 @@ Eigen::VectorXd in_layout(const Model& model, const ShapeByBody& shape) {
 void modal_responses(const Study& study, int analysis, const Model& model,
                      const ModalResult& result, const ModeShapes* references,
                      std::vector<double>& values, std::vector<std::string>& warnings,
-                     ModeShapes* selected) {
+                     ModeShapes* selected, std::vector<int>* chosen) {
+  if (chosen) chosen->assign(study.responses.size(), -1);
   for (size_t k = 0; k < study.responses.size(); ++k) {
     const ResponseSpec& r = study.responses[k];
     if (r.analysis != analysis || r.quantity != ResponseSpec::Quantity::kFrequency) continue;
@@ -138,6 +139,7 @@ void modal_responses(const Study& study, int analysis, const Model& model,
       mode = elastic_mode(result, r.mode);
     }
     values[k] = mode ? mode->frequency_hz : std::numeric_limits<double>::quiet_NaN();
+    if (chosen && mode) (*chosen)[k] = static_cast<int>(mode - result.modes.data());
     if (r.track && selected && mode)
       (*selected)[static_cast<int>(k)] = shape_by_body(model, mode->shape);
   }

@@ -45,11 +45,13 @@ using ModeShapes = std::map<int, ShapeByBody>;
 // dominant direction, or, for a tracked response with a reference shape in `references`, the mode
 // whose shape has the largest MAC against it. Warns (into `warnings`) of a dominant direction no
 // computed mode has and of a tracked mode that resembles its reference poorly (MAC below
-// kTrackedModeMac). The shapes of the modes tracked responses read go to `selected` (when given).
+// kTrackedModeMac). The shapes of the modes tracked responses read go to `selected` (when given);
+// `chosen` (when given) receives per study response the index in result.modes of the mode it read,
+// or -1.
 void modal_responses(const Study& study, int analysis, const Model& model,
                      const ModalResult& result, const ModeShapes* references,
                      std::vector<double>& values, std::vector<std::string>& warnings,
-                     ModeShapes* selected);
+                     ModeShapes* selected, std::vector<int>* chosen = nullptr);
 
 // Below this MAC against its reference a tracked mode is reported with a warning.
 inline constexpr double kTrackedModeMac = 0.5;

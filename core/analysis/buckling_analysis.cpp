@@ -133,6 +133,86 @@ double buckling_factor(const BucklingResult& result, int k) {
   return result.modes[k - 1].factor;
 }
 
+BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, double t,
+                                   Data& data, bool symmetric_reference) {
+  BucklingMatrices out;
+  const double length = characteristic_length(reference);
+  if (reference.n_dofs == 0) throw std::runtime_error("the scene has no free body");
+
+  // K0: the tangent at the reference, with the constant loads' stiffness.
+  compute_tangent(reference, data, t, false, 1.0);
+  double asymmetry = 0.0;
+  out.k0 = symmetric_stiffness(reference, data, stiffness_weights(reference, data), &asymmetry);
+  if (symmetric_reference && asymmetry > kModalAsymmetryLimit)
+    throw std::runtime_error(
+        text("the reference state's tangent stiffness is not symmetric (relative asymmetry "
+             "%.2g): torques of fixed direction load it, which are not conservative; linear "
+             "buckling does not apply (a static analysis's stability check does)",
+             asymmetry));
+  // The scaled loads at the reference, P1 (generalized forces, dim n_dofs).
+  for (Vec6& w : data.wrench) w.setZero();
+  add_load_wrenches(scaled, data, t, 1.0);
+  const Eigen::VectorXd p1 = wrench_vector(scaled, data);
+  if (!(p1.lpNorm<Eigen::Infinity>() > 0.0))
+    throw std::runtime_error("the loads to scale are zero at the loads' time: nothing buckles");
+  for (const Load& load : scaled.loads)
+    if (load.kind == LoadKind::kTorque && load.time(t) * load.value != Vec3::Zero())
+      throw std::runtime_error(
+          "a torque of fixed direction is among the loads to scale: it is not conservative; "
+          "linear buckling does not apply (a static analysis's stability check does)");
+
+  out.llt = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>(out.k0);
+  if (out.llt->info() != Eigen::Success)
+    throw std::runtime_error(
+        "the reference state's tangent stiffness is not positive definite: a body or "
+        "mechanism is free to move (a free body, or a carriage free along its rails), or the "
+        "constant loads already buckle the structure; buckling needs every body held");
+  const Eigen::VectorXd u1 = out.llt->solve(p1);
+  if (!u1.allFinite() || !((out.k0 * u1 - p1).norm() <= 1e-6 * p1.norm()))
+    throw std::runtime_error(
+        "the reference state's tangent stiffness is singular (a body or mechanism free to "
+        "move): buckling needs every body held");
+
+  // K1 = d K / d lambda: the element tangent's central differences along u1 at steps h and
+  // h / 2, extrapolated, plus the load stiffness's change (exact).
+  const double h = kStep / std::max(motion_scale(u1, length), 1e-300);
+  const Saved saved{data.pose, data.q, data.rotation};
+  std::vector<Mat6> d1(data.stiffness.size()), d2(data.stiffness.size());
+  {
+    const auto plus = element_tangent_at(reference, data, saved, u1, h, t);
+    const auto minus = element_tangent_at(reference, data, saved, u1, -h, t);
+    const auto half_plus = element_tangent_at(reference, data, saved, u1, 0.5 * h, t);
+    const auto half_minus = element_tangent_at(reference, data, saved, u1, -0.5 * h, t);
+    for (size_t b = 0; b < d1.size(); ++b)
+      d1[b] = (4.0 * (half_plus[b] - half_minus[b]) / h - (plus[b] - minus[b]) / (2.0 * h)) / 3.0;
+  }
+  data.pose = saved.pose;
+  data.q = saved.q;
+  data.rotation = saved.rotation;
+  // Forces at body points: d/dlambda of [F]x [R]x, the constant loads' levers turning with
+  // u1's rotation theta (dR = theta x R), the scaled loads' own values.
+  const auto add_load_part = [&](const Model& m, bool turning) {
+    for (const Load& load : m.loads) {
+      const int k = m.bodies[load.body].free_index;
+      if (k < 0 || load.kind != LoadKind::kForce) continue;
+      const Vec3 force = load.time(t) * load.value;
+      const Vec3 lever = data.pose[load.body].A * load.offset;
+      const Vec3 theta = u1.segment<3>(kDofsPerBody * k + 3);
+      d1[k].block<3, 3>(3, 3) += turning
+                                     ? Mat3(skew<double>(force) * skew<double>(theta.cross(lever)))
+                                     : Mat3(skew<double>(force) * skew<double>(lever));
+    }
+  };
+  add_load_part(reference, true);
+  add_load_part(scaled, false);
+  d2.swap(data.stiffness);
+  data.stiffness = d1;
+  out.k1 = symmetric_stiffness(reference, data, stiffness_weights(reference, data), &out.asymmetry);
+  data.stiffness.swap(d2);  // K0's blocks again
+  out.u1 = u1;
+  return out;
+}
+
 BucklingResult solve_buckling(const Model& reference, const Model& scaled,
                               const BucklingOptions& options, Data& data) {
   const auto start = Clock::now();
@@ -142,42 +222,7 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
     const double t = options.time;
     const double length = characteristic_length(reference);
     const Eigen::Index n = reference.n_dofs;
-    if (n == 0) throw std::runtime_error("the scene has no free body");
-
-    // K0: the tangent at the reference, with the constant loads' stiffness.
-    compute_tangent(reference, data, t, false, 1.0);
-    double asymmetry = 0.0;
-    const SparseMatrix k0 =
-        symmetric_stiffness(reference, data, stiffness_weights(reference, data), &asymmetry);
-    if (asymmetry > kModalAsymmetryLimit)
-      throw std::runtime_error(
-          text("the reference state's tangent stiffness is not symmetric (relative asymmetry "
-               "%.2g): torques of fixed direction load it, which are not conservative; linear "
-               "buckling does not apply (a static analysis's stability check does)",
-               asymmetry));
-    // The scaled loads at the reference, P1 (generalized forces, dim n_dofs).
-    for (Vec6& w : data.wrench) w.setZero();
-    add_load_wrenches(scaled, data, t, 1.0);
-    const Eigen::VectorXd p1 = wrench_vector(scaled, data);
-    if (!(p1.lpNorm<Eigen::Infinity>() > 0.0))
-      throw std::runtime_error("the loads to scale are zero at the loads' time: nothing buckles");
-    for (const Load& load : scaled.loads)
-      if (load.kind == LoadKind::kTorque && load.time(t) * load.value != Vec3::Zero())
-        throw std::runtime_error(
-            "a torque of fixed direction is among the loads to scale: it is not conservative; "
-            "linear buckling does not apply (a static analysis's stability check does)");
-
-    const Eigen::SimplicialLLT<SparseMatrix> llt(k0);
-    if (llt.info() != Eigen::Success)
-      throw std::runtime_error(
-          "the reference state's tangent stiffness is not positive definite: a body or "
-          "mechanism is free to move (a free body, or a carriage free along its rails), or the "
-          "constant loads already buckle the structure; buckling needs every body held");
-    const Eigen::VectorXd u1 = llt.solve(p1);
-    if (!u1.allFinite() || !((k0 * u1 - p1).norm() <= 1e-6 * p1.norm()))
-      throw std::runtime_error(
-          "the reference state's tangent stiffness is singular (a body or mechanism free to "
-          "move): buckling needs every body held");
+    const BucklingMatrices matrices = buckling_matrices(reference, scaled, t, data);
     if (!held_by_beams(reference)) {
       // Rails and free bodies may leave directions without stiffness that a Cholesky factor
       // still passes at rounding level: those have no modes of their own to lose.
@@ -194,47 +239,11 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
             "carriage free along its rails): buckling needs every body held");
     }
     deadline.check();
-
-    // K1 = d K / d lambda: the element tangent's central differences along u1 at steps h and
-    // h / 2, extrapolated, plus the load stiffness's change (exact).
-    const double h = kStep / std::max(motion_scale(u1, length), 1e-300);
     result.step = kStep;
-    const Saved saved{data.pose, data.q, data.rotation};
-    std::vector<Mat6> d1(data.stiffness.size()), d2(data.stiffness.size());
-    {
-      const auto plus = element_tangent_at(reference, data, saved, u1, h, t);
-      const auto minus = element_tangent_at(reference, data, saved, u1, -h, t);
-      const auto half_plus = element_tangent_at(reference, data, saved, u1, 0.5 * h, t);
-      const auto half_minus = element_tangent_at(reference, data, saved, u1, -0.5 * h, t);
-      for (size_t b = 0; b < d1.size(); ++b)
-        d1[b] = (4.0 * (half_plus[b] - half_minus[b]) / h - (plus[b] - minus[b]) / (2.0 * h)) / 3.0;
-    }
-    data.pose = saved.pose;
-    data.q = saved.q;
-    data.rotation = saved.rotation;
-    deadline.check();
-    // Forces at body points: d/dlambda of [F]x [R]x, the constant loads' levers turning with
-    // u1's rotation theta (dR = theta x R), the scaled loads' own values.
-    const auto add_load_part = [&](const Model& m, bool turning) {
-      for (const Load& load : m.loads) {
-        const int k = m.bodies[load.body].free_index;
-        if (k < 0 || load.kind != LoadKind::kForce) continue;
-        const Vec3 force = load.time(t) * load.value;
-        const Vec3 lever = data.pose[load.body].A * load.offset;
-        const Vec3 theta = u1.segment<3>(kDofsPerBody * k + 3);
-        d1[k].block<3, 3>(3, 3) +=
-            turning ? Mat3(skew<double>(force) * skew<double>(theta.cross(lever)))
-                    : Mat3(skew<double>(force) * skew<double>(lever));
-      }
-    };
-    add_load_part(reference, true);
-    add_load_part(scaled, false);
-    d2.swap(data.stiffness);
-    data.stiffness = d1;
-    const SparseMatrix k1 =
-        symmetric_stiffness(reference, data, stiffness_weights(reference, data), &result.asymmetry);
-    data.stiffness.swap(d2);  // K0's blocks again
-    const SparseMatrix minus_k1 = -k1;
+    result.asymmetry = matrices.asymmetry;
+    const SparseMatrix& k0 = matrices.k0;
+    const Eigen::SimplicialLLT<SparseMatrix>& llt = *matrices.llt;
+    const SparseMatrix minus_k1 = -matrices.k1;
 
     // -K1 x = mu K0 x, mu = 1 / lambda: the largest positive mu are the lowest positive factors.
     const int wanted = std::max(1, options.modes);

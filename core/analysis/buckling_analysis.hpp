@@ -22,7 +22,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCholesky>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -62,6 +64,21 @@ struct BucklingResult {
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
 };
+
+// The matrices of the buckling eigenproblem about the state in data.pose (symmetric parts;
+// `reference` and `scaled` as for solve_buckling), u1 = K0^-1 P1, and K0's Cholesky factors.
+// Throws std::runtime_error when the problem does not apply (non-conservative loads, nothing to
+// scale, K0 not positive definite). data.pose is left as it was; data.stiffness holds K0's blocks.
+struct BucklingMatrices {
+  Eigen::SparseMatrix<double> k0, k1;
+  Eigen::VectorXd u1;
+  double asymmetry = 0.0;  // of K1's element part
+  std::shared_ptr<const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>> llt;
+};
+// `symmetric_reference`: refuse a reference state whose K0 is not symmetric (false for states near
+// but not at an equilibrium, whose rounding-level asymmetry means nothing).
+BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, double t,
+                                   Data& data, bool symmetric_reference = true);
 
 // Solves the buckling eigenproblem about the state in data.pose: `reference` is the structure
 // with the loads that stay constant (data.pose is its equilibrium under them, or its initial

@@ -12,6 +12,7 @@
 #include "optimizer/optimize.hpp"
 #include "optimizer/output_folder.hpp"
 #include "optimizer/run_settings.hpp"
+#include "optimizer/sensitivity_study.hpp"
 #include "optimizer/study.hpp"
 #include "optimizer/summary.hpp"
 #include "optimizer/sweep.hpp"
@@ -142,6 +143,7 @@ std::string resumable_table(const Study& study) {
     case DesignStudy::Type::kOptimize:
       return "history.csv";
     case DesignStudy::Type::kWorkPrecision:
+    case DesignStudy::Type::kSensitivity:
       break;
   }
   return "";
@@ -216,6 +218,8 @@ int run(const RunArguments& args) {
         return run_optimize(*study, settings);
       case DesignStudy::Type::kWorkPrecision:
         return run_work_precision(*study, settings);
+      case DesignStudy::Type::kSensitivity:
+        return run_sensitivity(*study, settings);
     }
   }
   return run_single(*study, out);

@@ -6,10 +6,13 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
+#include <set>
 
 #include "core/analysis/stop_request.hpp"
 #include "optimizer/batch_table.hpp"
@@ -58,12 +61,18 @@ class Optimization {
  private:
   struct Start {
     Optimization* self = nullptr;
-    int index = 0;                  // 1-based
-    std::map<Design, int> numbers;  // distinct designs of this start -> evaluation number
-    nlopt_opt opt = nullptr;        // while it runs
+    int index = 0;  // 1-based
+    // Distinct designs of this start -> evaluation number: its rows of history.csv, what its
+    // design budget (max_evaluations) counts.
+    std::map<Design, int> numbers;
+    nlopt_opt opt = nullptr;  // while it runs
     nlopt_result result = NLOPT_SUCCESS;
     std::string message;   // NLopt's own message on an error
     bool stopped = false;  // stopped by us (a stop request or a write error)
+    // Stopped by us because NLopt's next call needed more designs than the budget had left
+    // (budget_needed of them); its result is then reported as MAXEVAL_REACHED.
+    bool budget_spent = false;
+    long budget_needed = 0;
     int nlopt_evaluations = 0;
     double objective_scale = 1.0;  // NLopt sees objective / this: |objective| at the start point
   };
@@ -78,9 +87,16 @@ class Optimization {
   double objective_of(const DesignOutcome& o) const;
   double constraint_of(const DesignOutcome& o, int j) const;
   bool feasible(const DesignOutcome& o) const;
+  // What the progress line shows of a feasible record: "mass 16.32" (the objective's response) or
+  // "objective 0.0012" (a target).
+  std::string best_text(const Record& r) const;
+  void show_progress();
 
   // The outcomes of designs xs for a start, evaluated in parallel where new, recorded in order.
-  std::vector<DesignOutcome> outcomes(Start& start, const std::vector<Design>& xs, bool parallel);
+  // A call is evaluated whole or not at all: nullopt (nothing evaluated, NLopt told to stop) when
+  // the designs new to the start would take it beyond its budget of max_evaluations designs.
+  std::optional<std::vector<DesignOutcome>> outcomes(Start& start, const std::vector<Design>& xs,
+                                                     bool parallel);
   // Value and (when grad != nullptr) central-difference gradient of f(outcome) at x.
   template <class F>
   double value_and_gradient(Start& start, const double* x, double* grad, F&& f);
@@ -95,6 +111,7 @@ class Optimization {
   void run_start(Start& start, const Design& x0);
   std::vector<Design> start_points() const;
   CsvRow row(const Record& r) const;
+  std::string stop_reason(const Start& st) const;
   int report(const Record* best, const std::vector<Start>& starts, double wall,
              const std::string& history_error) const;
 
@@ -109,6 +126,11 @@ class Optimization {
   std::vector<Record> records_;
   std::mutex mutex_;
   std::atomic<long> simulated_{0}, failures_{0};
+  // The progress line: designs the starts have taken (simulated or from the cache) and the design
+  // budget left to them (max_evaluations per start, lowered to what a finished start took).
+  std::atomic<long> done_{0}, budget_total_{0};
+  double best_objective_ = kPenalty;  // of the feasible records so far (under mutex_)
+  std::string best_text_;
   std::atomic<bool> write_failed_{false};
   int threads_ = 1;
 };
@@ -176,19 +198,62 @@ CsvRow Optimization::row(const Record& r) const {
   return out;
 }
 
-std::vector<DesignOutcome> Optimization::outcomes(Start& start, const std::vector<Design>& xs,
-                                                  bool parallel) {
+std::string Optimization::best_text(const Record& r) const {
+  const auto short_number = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return std::string(buf);
+  };
+  switch (plan_.goal) {
+    case OptimizePlan::Goal::kMinimize:
+    case OptimizePlan::Goal::kMaximize:
+      return study_.responses[plan_.response].name + " " +
+             short_number(r.outcome.responses[plan_.response]);
+    default:
+      return "objective " + short_number(r.objective);
+  }
+}
+
+void Optimization::show_progress() {
+  std::string best;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    best = best_text_;
+  }
+  progress_.update(done_, failures_, best);
+}
+
+std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
+                                                                 const std::vector<Design>& xs,
+                                                                 bool parallel) {
   std::vector<DesignOutcome> out(xs.size());
   std::vector<char> known(xs.size(), 0);
   std::vector<int> numbers(xs.size());
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    // The start's design budget: every design new to the start counts, simulated now or taken
+    // from the cache (another start's, or history.csv's on --resume), so that a resumed run stops
+    // where the uninterrupted one did. A call that does not fit is not evaluated at all.
+    std::set<Design> fresh;
+    for (const Design& x : xs)
+      if (!start.numbers.count(x)) fresh.insert(x);
+    if (start.numbers.size() + fresh.size() > static_cast<size_t>(plan_.max_evaluations)) {
+      if (!start.budget_spent) {
+        start.budget_spent = true;
+        start.budget_needed = static_cast<long>(fresh.size());
+      }
+      if (start.opt) nlopt_force_stop(start.opt);
+      return std::nullopt;
+    }
     for (size_t i = 0; i < xs.size(); ++i) {
-      auto [it, fresh] =
+      auto [it, is_new] =
           start.numbers.try_emplace(xs[i], static_cast<int>(start.numbers.size()) + 1);
-      numbers[i] = fresh ? it->second : -it->second;  // negative: this start has its row already
+      numbers[i] = is_new ? it->second : -it->second;  // negative: this start has its row already
       const auto c = cache_.find(xs[i]);
-      if (c != cache_.end()) out[i] = c->second, known[i] = 1;
+      if (c != cache_.end()) {
+        out[i] = c->second, known[i] = 1;
+        if (is_new) ++done_;
+      }
     }
   }
   const long n = static_cast<long>(xs.size());
@@ -205,18 +270,27 @@ std::vector<DesignOutcome> Optimization::outcomes(Start& start, const std::vecto
       if (out[i].status == "interrupted") continue;
       ++simulated_;
       if (out[i].status != "ok") ++failures_;
+      if (numbers[i] > 0) ++done_;
+      show_progress();
     }
-  std::lock_guard<std::mutex> lock(mutex_);
-  for (size_t i = 0; i < xs.size(); ++i) {
-    // An interrupted design is no result: neither cached nor in the history (a resumed run
-    // evaluates it).
-    if (out[i].status == "interrupted") continue;
-    cache_.try_emplace(xs[i], out[i]);
-    if (numbers[i] < 0) continue;
-    Record r{start.index, numbers[i], xs[i], out[i], objective_of(out[i]), feasible(out[i])};
-    if (!history_.append(row(r))) write_failed_ = true;
-    records_.push_back(std::move(r));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (size_t i = 0; i < xs.size(); ++i) {
+      // An interrupted design is no result: neither cached nor in the history (a resumed run
+      // evaluates it).
+      if (out[i].status == "interrupted") continue;
+      cache_.try_emplace(xs[i], out[i]);
+      if (numbers[i] < 0) continue;
+      Record r{start.index, numbers[i], xs[i], out[i], objective_of(out[i]), feasible(out[i])};
+      if (!history_.append(row(r))) write_failed_ = true;
+      if (r.feasible && r.objective < best_objective_) {
+        best_objective_ = r.objective;
+        best_text_ = best_text(r);
+      }
+      records_.push_back(std::move(r));
+    }
   }
+  show_progress();
   return out;
 }
 
@@ -236,7 +310,12 @@ double Optimization::value_and_gradient(Start& start, const double* x, double* g
       points.push_back(down);
     }
   }
-  const std::vector<DesignOutcome> o = outcomes(start, points, true);
+  const std::optional<std::vector<DesignOutcome>> evaluated = outcomes(start, points, true);
+  if (!evaluated) {  // beyond the start's design budget: nothing evaluated, NLopt stops
+    if (grad) std::fill(grad, grad + n, 0.0);
+    return kPenalty;
+  }
+  const std::vector<DesignOutcome>& o = *evaluated;
   const double value = f(o[0]);
   if (grad)
     for (size_t i = 0; i < n; ++i) {
@@ -280,8 +359,6 @@ double Optimization::objective_callback(unsigned, const double* x, double* grad,
       start->stopped = true;
       nlopt_force_stop(start->opt);
     }
-    std::string best;
-    self.progress_.update(self.simulated_, self.failures_, best);
     return v;
   } catch (...) {
     return kPenalty;  // never throw through NLopt
@@ -324,13 +401,18 @@ void Optimization::run_start(Start& start, const Design& x0) {
     refs.push_back(ConstraintRef{&start, static_cast<int>(j)});
   for (ConstraintRef& ref : refs)
     nlopt_add_inequality_constraint(opt, constraint_callback, &ref, 1e-8);
+  // The design budget (max_evaluations designs per start) is enforced in outcomes(); NLopt's own
+  // limit on its calls is the same number, which stops a start whose calls keep returning to
+  // designs it has evaluated (they cost no budget). Without gradients a call is one design: the
+  // two limits coincide.
   nlopt_set_maxeval(opt, plan_.max_evaluations);
   if (plan_.max_seconds > 0) nlopt_set_maxtime(opt, plan_.max_seconds);
   nlopt_srand(plan_.seed + static_cast<unsigned long>(start.index));  // stochastic algorithms
 
   // The objective's scale: its magnitude at the start point (constraints are already relative to
   // their bounds).
-  const double f0 = objective_of(outcomes(start, {x0}, false)[0]);
+  const std::optional<std::vector<DesignOutcome>> o0 = outcomes(start, {x0}, false);
+  const double f0 = o0 ? objective_of((*o0)[0]) : kPenalty;
   start.objective_scale = f0 < kPenalty && std::abs(f0) > 0.0 ? std::abs(f0) : 1.0;
   Design x(x0.size());
   for (size_t i = 0; i < x0.size(); ++i) x[i] = scaled_variable(variables_[i], x0[i]);
@@ -339,6 +421,58 @@ void Optimization::run_start(Start& start, const Design& x0) {
   start.result = nlopt_optimize(opt, x.data(), &f);
   if (start.result < 0 && nlopt_get_errmsg(opt)) start.message = nlopt_get_errmsg(opt);
   start.opt = nullptr;
+  // Spending the design budget is a normal stop (NLopt returns FORCED_STOP, or whatever it made of
+  // the penalty values it got after the stop): reported as NLopt reports its own limit.
+  if (start.budget_spent && !start.stopped) start.result = NLOPT_MAXEVAL_REACHED;
+  // The start is done: the progress total keeps only the designs it took of its budget.
+  std::lock_guard<std::mutex> lock(mutex_);
+  budget_total_ -= plan_.max_evaluations - static_cast<long>(start.numbers.size());
+  progress_.set_total(budget_total_);
+}
+
+// Why a start stopped, in words.
+std::string Optimization::stop_reason(const Start& st) const {
+  const std::string budget = std::to_string(plan_.max_evaluations);
+  switch (st.result) {
+    case NLOPT_SUCCESS:
+      return "the algorithm's own convergence test was met";
+    case NLOPT_STOPVAL_REACHED:
+      return "the objective reached NLopt's stopval";
+    case NLOPT_FTOL_REACHED:
+      return "a step changed the objective by less than ftol_rel (" +
+             format_number(plan_.ftol_rel) + ") of its value";
+    case NLOPT_XTOL_REACHED:
+      return "a step changed every variable, scaled to [0, 1] by its bounds, by less than "
+             "xtol_rel (" +
+             format_number(plan_.xtol_rel) + ") of its value";
+    case NLOPT_MAXEVAL_REACHED:
+      if (st.budget_spent)
+        return "the design budget is spent: the start had evaluated " +
+               std::to_string(st.numbers.size()) + " of its " + budget +
+               " designs (max_evaluations) and NLopt's next call needed " +
+               std::to_string(st.budget_needed) + " more; beamrail stopped NLopt without it";
+      return "NLopt reached its own limit of max_evaluations (" + budget + ") calls" +
+             (needs_gradient(plan_.algorithm)
+                  ? std::string(" (calls at designs the start had evaluated cost no designs)")
+                  : std::string(" (without gradients a call is one design at most)"));
+    case NLOPT_MAXTIME_REACHED:
+      return "the start ran for max_seconds (" + format_number(plan_.max_seconds) + " s)";
+    case NLOPT_ROUNDOFF_LIMITED:
+      return "roundoff errors limited NLopt's progress: the best design may not be an optimum";
+    case NLOPT_FORCED_STOP:
+      return st.stopped ? "beamrail stopped NLopt: a stop was requested (SIGINT, SIGTERM) or "
+                          "history.csv could not be written"
+                        : "NLopt was forced to stop, not by beamrail";
+    case NLOPT_FAILURE:
+      return "NLopt failed" + (st.message.empty() ? std::string() : ": " + st.message);
+    case NLOPT_INVALID_ARGS:
+      return "NLopt refused its arguments" +
+             (st.message.empty() ? std::string() : ": " + st.message);
+    case NLOPT_OUT_OF_MEMORY:
+      return "NLopt ran out of memory";
+    default:
+      return "NLopt returned " + std::to_string(static_cast<int>(st.result));
+  }
 }
 
 // What a start's NLopt result means for the study: "" (a normal stop), or a warning, or an error.
@@ -409,12 +543,28 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
   s["status"] = status;
   s["message"] = message;
   s["warnings"] = warnings;
+  s["max_evaluations"] = plan_.max_evaluations;
   nlohmann::json per_start = nlohmann::json::array();
-  for (const Start& st : starts)
+  for (const Start& st : starts) {
+    // The start's best feasible design; ties go to its earliest evaluation (records_ is sorted).
+    const Record* own = nullptr;
+    for (const Record& r : records_)
+      if (r.start == st.index && r.feasible && (!own || r.objective < own->objective)) own = &r;
+    nlohmann::json start_best = nullptr;
+    if (own) {
+      nlohmann::json vars = nlohmann::json::object();
+      for (size_t i = 0; i < variables_.size(); ++i) vars[variables_[i].name] = own->x[i];
+      start_best = {{"evaluation", own->evaluation},
+                    {"objective", json_number(own->objective)},
+                    {"variables", vars}};
+    }
     per_start.push_back({{"start", st.index},
                          {"nlopt_result", nlopt_result_to_string(st.result)},
+                         {"stop_reason", stop_reason(st)},
                          {"nlopt_evaluations", st.nlopt_evaluations},
-                         {"designs", st.numbers.size()}});
+                         {"designs", st.numbers.size()},
+                         {"best", start_best}});
+  }
   s["starts"] = per_start;
   s["designs_simulated"] = simulated_.load();
   s["designs_failed"] = failures_.load();
@@ -538,6 +688,8 @@ int Optimization::run() {
       std::max(static_cast<long>(points.size()),
                needs_gradient(plan_.algorithm) ? 2 * static_cast<long>(variables_.size()) + 1 : 1);
   threads_ = batch_threads(settings_, at_once);
+  budget_total_ = static_cast<long>(plan_.max_evaluations) * static_cast<long>(points.size());
+  progress_.set_total(budget_total_);
   std::vector<Start> starts(points.size());
   for (size_t s = 0; s < points.size(); ++s)
     starts[s].self = this, starts[s].index = static_cast<int>(s) + 1;

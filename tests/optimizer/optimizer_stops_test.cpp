@@ -1,14 +1,19 @@
 // How an optimization ends, through the real command line: NLopt combinations it cannot run are
 // bad input when the study is read (not a start point reported as the optimum), wrappers get the
 // local optimizers they need (MLSL inside an augmented Lagrangian, LN_AUGLAG itself), an NLopt
-// failure fails the study, and ROUNDOFF_LIMITED is reported as a warning.
+// failure fails the study, ROUNDOFF_LIMITED is reported as a warning, a start stops when it has
+// evaluated max_evaluations designs (not NLopt calls), and each start reports why it stopped and
+// its best design.
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -36,6 +41,24 @@ Json load_json(const fs::path& path) { return Json::parse(read_text(path)); }
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  for (size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '\n') lines.push_back(text.substr(start, i - start)), start = i + 1;
+  return lines;
+}
+
+// The rows of history.csv per start (its first column); the tables here have no quoted fields
+// before the message column.
+std::map<int, int> rows_per_start(const std::string& history) {
+  std::map<int, int> rows;
+  const std::vector<std::string> lines = lines_of(history);
+  for (size_t i = 1; i < lines.size(); ++i)
+    ++rows[std::stoi(lines[i].substr(0, lines[i].find(',')))];
+  return rows;
 }
 
 // The lightest rod keeping f1 >= 20 Hz (studies/min_mass_rod.json): the optimum is d* = 48.20 mm
@@ -185,6 +208,110 @@ TEST_F(OptimizerStops, AnNloptFailureFailsTheStudy) {
   EXPECT_FALSE(fs::exists(dir_ / "out" / "best.json"));
   EXPECT_FALSE(fs::exists(dir_ / "out" / "best_scene.json"));
   EXPECT_FALSE(summary.contains("best"));
+  // The start's stop in words, and the best feasible design it evaluated, given for information.
+  EXPECT_EQ(summary["starts"][0]["best"]["evaluation"], summary["best_evaluated"]["evaluation"]);
+  EXPECT_TRUE(contains(summary["starts"][0]["stop_reason"], "NLopt failed")) << summary["starts"];
+}
+
+// No feasible design: the study is infeasible, and the start reports no best design (null).
+TEST_F(OptimizerStops, AStartWithoutAFeasibleDesignReportsNoBest) {
+  Json s = rod("LN_COBYLA", 6);
+  s["study"]["constraints"][0][">="] = 1e6;  // f1 >= 1 MHz
+  const ProcessResult r = run("infeasible.json", s);
+  ASSERT_TRUE(r.exited) << r.how;
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  std::printf("%s: %s%s\n", r.how.c_str(), r.err.c_str(), summary["starts"].dump().c_str());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(summary["status"], "infeasible");
+  ASSERT_EQ(summary["starts"].size(), 1u);
+  EXPECT_TRUE(summary["starts"][0]["best"].is_null());
+  // COBYLA returned to a design (at the upper bound): 6 calls, 5 designs.
+  EXPECT_LE(summary["starts"][0]["designs"].get<int>(), 6);
+  EXPECT_EQ(summary["starts"][0]["designs"], summary["designs_in_history"]);
+  EXPECT_EQ(summary["starts"][0]["nlopt_result"], "MAXEVAL_REACHED");
+  EXPECT_FALSE(summary.contains("best_evaluated"));
+}
+
+// max_evaluations is the number of designs a start evaluates. A gradient call costs 2n + 1 designs
+// (central differences: 3 for the rod's one variable): once NLopt's next call would take a start
+// beyond the budget, it is not evaluated and NLopt is stopped; the start reports MAXEVAL_REACHED,
+// a normal stop. (NLopt's own call limit, the former meaning, let 10 evaluations cost up to 30
+// designs.) The rod's start point is 1 design, NLopt's first call at it 2 more, each further call
+// 3: with 10 designs allowed, a start ends after 9, its next call needing 3.
+TEST_F(OptimizerStops, AGradientStartStopsWhenItsDesignBudgetIsSpent) {
+  for (const std::string algorithm : {"LD_SLSQP", "LD_MMA"}) {
+    SCOPED_TRACE(algorithm);
+    Json s = rod(algorithm, 10);
+    s["study"]["starts"] = 2;
+    s["study"]["variables"][0]["initial"] =
+        0.09;  // far from the optimum: 10 designs do not reach it
+    const ProcessResult r = run("budget.json", s);
+    ASSERT_TRUE(r.exited && r.status == 0) << r.how << "\n" << r.err;
+    const Json summary = load_json(dir_ / "out" / "summary.json");
+    const std::string history = read_text(dir_ / "out" / "history.csv");
+    const std::map<int, int> rows = rows_per_start(history);
+    std::printf("%s: %s\n", algorithm.c_str(), summary["starts"].dump(1).c_str());
+    EXPECT_EQ(summary["status"], "ok");
+    EXPECT_EQ(summary["max_evaluations"], 10);
+    EXPECT_TRUE(fs::exists(dir_ / "out" / "best.json"));
+    ASSERT_EQ(summary["starts"].size(), 2u);
+    ASSERT_EQ(rows.size(), 2u);
+    for (const Json& st : summary["starts"]) {
+      const int index = st["start"];
+      SCOPED_TRACE("start " + std::to_string(index));
+      EXPECT_EQ(st["nlopt_result"], "MAXEVAL_REACHED");
+      EXPECT_TRUE(contains(st["stop_reason"],
+                           "the design budget is spent: the start had evaluated "
+                           "9 of its 10 designs (max_evaluations) and NLopt's "
+                           "next call needed 3 more"))
+          << st["stop_reason"];
+      EXPECT_EQ(st["designs"], 9);
+      EXPECT_EQ(rows.at(index), 9);
+      EXPECT_LE(rows.at(index), 10);
+      EXPECT_TRUE(st["best"].is_object());
+    }
+    EXPECT_EQ(summary["designs_in_history"], 18);
+    EXPECT_LE(summary["designs_simulated"].get<int>(), 20);
+
+    // --resume replays the designs of history.csv, which count as before: the resumed run stops
+    // where this one did, with the same history and best design.
+    const std::string best = read_text(dir_ / "out" / "best.json");
+    const std::vector<std::string> lines = lines_of(history);
+    std::string half;
+    for (size_t i = 0; i <= lines.size() / 2; ++i) half += lines[i] + "\n";
+    std::ofstream(dir_ / "out" / "history.csv") << half;
+    fs::remove(dir_ / "out" / "summary.json");
+    std::vector<std::string> args{"run", "budget.json", "-o", "out", "--quiet", "--resume"};
+    const ProcessResult resumed =
+        testing::run_process(BEAMRAIL_EXECUTABLE, args, dir_, std::chrono::seconds(60));
+    ASSERT_TRUE(resumed.exited && resumed.status == 0) << resumed.how << "\n" << resumed.err;
+    const Json again = load_json(dir_ / "out" / "summary.json");
+    EXPECT_EQ(rows_per_start(read_text(dir_ / "out" / "history.csv")), rows);
+    EXPECT_EQ(read_text(dir_ / "out" / "best.json"), best);
+    EXPECT_EQ(again["starts"][0]["designs"], 9);
+    EXPECT_EQ(again["starts"][0]["nlopt_result"], "MAXEVAL_REACHED");
+    EXPECT_LE(again["designs_simulated"].get<int>(), 18 - static_cast<int>(lines.size() / 2));
+    fs::remove_all(dir_ / "out");
+  }
+}
+
+// Without gradients one NLopt call is one design, as before: LN_COBYLA with 10 designs allowed
+// evaluates 10 (its first call is the start point) and NLopt itself stops at its limit.
+TEST_F(OptimizerStops, ADerivativeFreeStartEvaluatesOneDesignPerCall) {
+  Json s = rod("LN_COBYLA", 10);
+  s["study"]["variables"][0]["initial"] = 0.09;
+  const ProcessResult r = run("cobyla.json", s);
+  ASSERT_TRUE(r.exited && r.status == 0) << r.how << "\n" << r.err;
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  const Json& st = summary["starts"][0];
+  std::printf("%s\n", st.dump(1).c_str());
+  EXPECT_EQ(st["nlopt_result"], "MAXEVAL_REACHED");
+  EXPECT_EQ(st["stop_reason"],
+            "NLopt reached its own limit of max_evaluations (10) calls (without gradients a call "
+            "is one design at most)");
+  EXPECT_EQ(st["nlopt_evaluations"], 10);
+  EXPECT_EQ(st["designs"], 10);
+  EXPECT_EQ(rows_per_start(read_text(dir_ / "out" / "history.csv")).at(1), 10);
 }
 
 // LD_SLSQP on the rod with f1 >= 23 Hz from d = 65 mm and central differences over 49 % of the

@@ -32,6 +32,17 @@ namespace {
 constexpr double kPenalty = 1e30;
 // A constraint counts as met up to this fraction of its bound.
 constexpr double kFeasibility = 1e-9;
+// A constraint of a reported design is "active" when its relative margin (the margin over |bound|,
+// or the margin itself for a bound of 0) is within max(kActiveFloor, kActiveFactor * xtol_rel) of
+// zero. NLopt stops once a step moves the scaled variables (in [0, 1]) by less than xtol_rel of
+// their value; a constraint the optimum rests on is then met to about its sensitivity (relative
+// change of the constraint per relative change of a variable: 1 for a frequency ~ d, 3 for a
+// stress ~ 1/d^3) times that step. The factor 10 covers sensitivities up to 10; the floor covers
+// the rounding of the responses (modal frequencies resolve to ~1e-8 and worse, see "Guarantees")
+// and NLopt's own constraint tolerance (1e-8, below). summary.json and best.json give the
+// tolerance used ("active_tolerance").
+constexpr double kActiveFloor = 1e-6;
+constexpr double kActiveFactor = 10.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool needs_gradient(const std::string& algorithm) {
@@ -87,6 +98,9 @@ class Optimization {
   double objective_of(const DesignOutcome& o) const;
   double constraint_of(const DesignOutcome& o, int j) const;
   bool feasible(const DesignOutcome& o) const;
+  double active_tolerance() const { return std::max(kActiveFloor, kActiveFactor * plan_.xtol_rel); }
+  // Per constraint: response, type, bound, value, margin, relative margin, active, satisfied.
+  nlohmann::json constraint_report(const DesignOutcome& o) const;
   // What the progress line shows of a feasible record: "mass 16.32" (the objective's response) or
   // "objective 0.0012" (a target).
   std::string best_text(const Record& r) const;
@@ -183,6 +197,39 @@ bool Optimization::feasible(const DesignOutcome& o) const {
   for (size_t j = 0; j < plan_.constraints.size(); ++j)
     if (!(constraint_of(o, static_cast<int>(j)) <= kFeasibility)) return false;
   return true;
+}
+
+nlohmann::json Optimization::constraint_report(const DesignOutcome& o) const {
+  nlohmann::json list = nlohmann::json::array();
+  const double tolerance = active_tolerance();
+  for (const Constraint& c : plan_.constraints) {
+    const double value = o.responses[c.response];
+    double margin = 0.0;  // positive: satisfied with room, in the response's units
+    const char* type = "";
+    switch (c.kind) {
+      case Constraint::Kind::kAtLeast:
+        margin = value - c.bound, type = ">=";
+        break;
+      case Constraint::Kind::kAtMost:
+        margin = c.bound - value, type = "<=";
+        break;
+      case Constraint::Kind::kAbsAtMost:
+        margin = c.bound - std::abs(value), type = "abs<=";
+        break;
+    }
+    // The negative of constraint_of(): satisfied is what feasible() requires of the constraint.
+    const double relative = c.bound != 0.0 ? margin / std::abs(c.bound) : margin;
+    const bool finite = std::isfinite(relative);
+    list.push_back({{"response", study_.responses[c.response].name},
+                    {"type", type},
+                    {"bound", c.bound},
+                    {"value", json_number(value)},
+                    {"margin", json_number(margin)},
+                    {"relative_margin", json_number(relative)},
+                    {"active", finite && std::abs(relative) <= tolerance},
+                    {"satisfied", finite && relative >= -kFeasibility}});
+  }
+  return list;
 }
 
 CsvRow Optimization::row(const Record& r) const {
@@ -544,6 +591,7 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
   s["message"] = message;
   s["warnings"] = warnings;
   s["max_evaluations"] = plan_.max_evaluations;
+  s["active_tolerance"] = active_tolerance();
   nlohmann::json per_start = nlohmann::json::array();
   for (const Start& st : starts) {
     // The start's best feasible design; ties go to its earliest evaluation (records_ is sorted).
@@ -591,6 +639,8 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
       resp[study_.responses[k].name] = json_number(best->outcome.responses[k]);
     b["variables"] = vars;
     b["responses"] = resp;
+    b["constraints"] = constraint_report(best->outcome);
+    b["active_tolerance"] = active_tolerance();
     if (status == "ok") {
       s["best"] = b;
       s["responses"] = resp;

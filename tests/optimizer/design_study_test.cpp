@@ -212,6 +212,44 @@ Json tube_grid(int n_d, int n_w, int segments = 0) {
 
 // --- 1. Closed-form optimum ---------------------------------------------------------------------
 
+// The first bending frequency of min_mass_rod's design with rod diameter d (see below), and the
+// diameter d* of the lightest rod meeting f1 >= 20 Hz.
+struct RodClosedForm {
+  double E, rho, m, J, L;
+  explicit RodClosedForm(const Json& study)
+      : E(study["scene"]["materials"]["steel"]["E"]),
+        rho(study["scene"]["materials"]["steel"]["density"]),
+        m(study["scene"]["bodies"][0]["mass"]),
+        J(study["scene"]["bodies"][0]["inertia"][2]),
+        L(study["scene"]["beams"][0]["point2"][0]) {}
+
+  // The rod's mass rho S L lies lumped at its ends (docs/model.md "Mass"): half of it at the tip,
+  // at the attachment point (the tip's centre), with the rotary inertia of a half-length slice
+  // about its centre plus its mass times (L/4)^2 about the bending axis.
+  double f1(double d) const {
+    const double area = M_PI * d * d / 4, inertia = M_PI * std::pow(d, 4) / 64;
+    const double half = rho * area * L / 2;
+    const double rotary =
+        rho * (L / 2) * inertia + half * (L / 2) * (L / 2) / 12 + half * (L / 4) * (L / 4);
+    Eigen::Matrix2d K, M;
+    K << 12 / (L * L * L), -6 / (L * L), -6 / (L * L), 4 / L;
+    K *= E * inertia;
+    M << m + half, 0, 0, J + rotary;
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> solver(K, M);
+    return std::sqrt(solver.eigenvalues()(0)) / (2 * M_PI);  // ascending
+  }
+  double mass(double d) const { return m + rho * M_PI * d * d * L / 4; }
+  // f1 grows with d over the bounds: bisection for f1(d*) = 20 Hz.
+  double d_star() const {
+    double lo = 0.005, hi = 0.1;
+    EXPECT_LT(f1(lo), 20.0);
+    EXPECT_GT(f1(hi), 20.0);
+    for (int k = 0; k < 200 && hi - lo > 1e-16; ++k)
+      (f1(0.5 * (lo + hi)) < 20.0 ? lo : hi) = 0.5 * (lo + hi);
+    return hi;
+  }
+};
+
 // min_mass_rod: an unsegmented solid rod cantilever (length L) carrying a tip body (mass m, rotary
 // inertia J about the bending axis, centre of mass at the beam tip); half the rod's mass lies
 // lumped at the tip. Its first bending frequency comes from the 2 x 2 tip problem
@@ -240,28 +278,9 @@ TEST_F(DesignStudyRuns, MinimumMassRodReachesTheClosedFormOptimum) {
   EXPECT_EQ(m, 2.0);
   EXPECT_EQ(J, 1e-3);
 
-  // The rod's mass rho S L lies lumped at its ends (docs/model.md "Mass"): half of it at the tip,
-  // at the attachment point (the tip's centre), with the rotary inertia of a half-length slice
-  // about its centre plus its mass times (L/4)^2 about the bending axis.
-  const auto f1_of = [&](double d) {
-    const double area = M_PI * d * d / 4, inertia = M_PI * std::pow(d, 4) / 64;
-    const double half = rho * area * L / 2;
-    const double rotary =
-        rho * (L / 2) * inertia + half * (L / 2) * (L / 2) / 12 + half * (L / 4) * (L / 4);
-    Eigen::Matrix2d K, M;
-    K << 12 / (L * L * L), -6 / (L * L), -6 / (L * L), 4 / L;
-    K *= E * inertia;
-    M << m + half, 0, 0, J + rotary;
-    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> solver(K, M);
-    return std::sqrt(solver.eigenvalues()(0)) / (2 * M_PI);  // ascending
-  };
-  // f1 grows with d over the bounds: bisection for f1(d*) = 20 Hz.
-  double lo = 0.005, hi = 0.1;
-  ASSERT_LT(f1_of(lo), 20.0);
-  ASSERT_GT(f1_of(hi), 20.0);
-  for (int k = 0; k < 200 && hi - lo > 1e-16; ++k)
-    (f1_of(0.5 * (lo + hi)) < 20.0 ? lo : hi) = 0.5 * (lo + hi);
-  const double d_star = hi;
+  const RodClosedForm rod_form(study);
+  const auto f1_of = [&](double d) { return rod_form.f1(d); };
+  const double d_star = rod_form.d_star();
   std::printf("closed form (2 x 2 tip problem, bisection): d* = %s m\n", g17(d_star).c_str());
 
   for (const std::string algorithm : {"LN_COBYLA", "LD_SLSQP"}) {
@@ -293,6 +312,103 @@ TEST_F(DesignStudyRuns, MinimumMassRodReachesTheClosedFormOptimum) {
     EXPECT_NEAR(mass / mass_formula - 1, 0.0, 1e-9);
     EXPECT_NEAR(f1 / f1_formula - 1, 0.0, 1e-9);
   }
+}
+
+// The constraint report (best.json, summary.json "best") and the starts' reports on min_mass_rod
+// with two more constraints that the optimum leaves slack: mass <= 20 kg and |f1| <= 100 Hz. At the
+// closed-form optimum d* (48.20 mm) f1 = 20 Hz (active, margin ~0) and the mass is m +
+// rho pi d*^2 L / 4 = 16.32 kg (margin 3.68 kg, 18 % of the bound: not active); |f1| <= 100 has
+// margin 80 Hz (80 %).
+TEST_F(DesignStudyRuns, ConstraintReportOfTheClosedFormOptimumNamesTheActiveConstraint) {
+  Json study = load_json(kStudies / "min_mass_rod.json");
+  const RodClosedForm form(study);
+  const double d_star = form.d_star(), mass_star = form.mass(d_star);
+  study["study"]["constraints"] = Json::parse(
+      R"([{"response": "f1", ">=": 20.0}, {"response": "mass", "<=": 20.0},
+          {"response": "f1", "abs<=": 100.0}])");
+  study["study"]["starts"] = 2;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("rod.json", study), "out"));
+  const Json best = load_json(dir_ / "out" / "best.json");
+  const Json summary = load_json(dir_ / "out" / "summary.json");
+  std::printf("d* = %s, mass* = %s\nbest.json constraints: %s\nstarts: %s\n", g17(d_star).c_str(),
+              g17(mass_star).c_str(), best["constraints"].dump(1).c_str(),
+              summary["starts"].dump(1).c_str());
+  ASSERT_EQ(summary["status"], "ok");
+  EXPECT_EQ(summary["best"], best);
+  const double d = best["variables"]["d"], f1 = best["responses"]["f1"],
+               mass = best["responses"]["mass"];
+  EXPECT_NEAR(d / d_star - 1, 0.0, 1e-6);
+  // xtol_rel 1e-10: the tolerance of "active" is its floor.
+  EXPECT_EQ(best["active_tolerance"], 1e-6);
+  EXPECT_EQ(summary["active_tolerance"], 1e-6);
+
+  const Json& c = best["constraints"];
+  ASSERT_EQ(c.size(), 3u);
+  // f1 >= 20: active, met.
+  EXPECT_EQ(c[0]["response"], "f1");
+  EXPECT_EQ(c[0]["type"], ">=");
+  EXPECT_EQ(c[0]["bound"], 20.0);
+  EXPECT_EQ(c[0]["value"], f1);
+  EXPECT_EQ(c[0]["margin"].get<double>(), f1 - 20.0);
+  EXPECT_EQ(c[0]["relative_margin"].get<double>(), (f1 - 20.0) / 20.0);
+  EXPECT_GE(c[0]["relative_margin"].get<double>(), -1e-9);
+  EXPECT_LE(c[0]["relative_margin"].get<double>(), 1e-6);
+  EXPECT_EQ(c[0]["active"], true);
+  EXPECT_EQ(c[0]["satisfied"], true);
+  // mass <= 20: 3.68 kg to spare.
+  EXPECT_EQ(c[1]["response"], "mass");
+  EXPECT_EQ(c[1]["type"], "<=");
+  EXPECT_EQ(c[1]["bound"], 20.0);
+  EXPECT_EQ(c[1]["value"], mass);
+  EXPECT_NEAR(mass / mass_star - 1, 0.0, 2e-6);
+  EXPECT_EQ(c[1]["margin"].get<double>(), 20.0 - mass);
+  EXPECT_NEAR(c[1]["margin"].get<double>(), 20.0 - mass_star, 1e-4);
+  EXPECT_NEAR(c[1]["margin"].get<double>(), 3.68, 0.01);
+  EXPECT_EQ(c[1]["relative_margin"].get<double>(), (20.0 - mass) / 20.0);
+  EXPECT_EQ(c[1]["active"], false);
+  EXPECT_EQ(c[1]["satisfied"], true);
+  // |f1| <= 100: 80 Hz to spare.
+  EXPECT_EQ(c[2]["response"], "f1");
+  EXPECT_EQ(c[2]["type"], "abs<=");
+  EXPECT_EQ(c[2]["bound"], 100.0);
+  EXPECT_EQ(c[2]["margin"].get<double>(), 100.0 - f1);
+  EXPECT_NEAR(c[2]["relative_margin"].get<double>(), 0.8, 1e-6);
+  EXPECT_EQ(c[2]["active"], false);
+  EXPECT_EQ(c[2]["satisfied"], true);
+
+  // Each start names its best feasible design, the minimum of its feasible rows in history.csv;
+  // the study's best is the better of the two.
+  const Table t = read_table(dir_ / "out" / "history.csv");
+  ASSERT_EQ(summary["starts"].size(), 2u);
+  double best_of_starts = INFINITY;
+  for (const Json& st : summary["starts"]) {
+    const std::string index = std::to_string(st["start"].get<int>());
+    SCOPED_TRACE("start " + index);
+    ASSERT_TRUE(st["best"].is_object()) << st.dump();
+    double lowest = INFINITY;
+    std::string lowest_evaluation, lowest_d;
+    for (size_t i = 0; i < t.rows.size(); ++i) {
+      if (t.at(i, "start") != index || t.at(i, "feasible") != "1") continue;
+      const double objective = std::strtod(t.at(i, "objective").c_str(), nullptr);
+      if (objective < lowest)
+        lowest = objective, lowest_evaluation = t.at(i, "evaluation"), lowest_d = t.at(i, "d");
+    }
+    EXPECT_EQ(st["best"]["objective"].get<double>(), lowest);
+    EXPECT_EQ(std::to_string(st["best"]["evaluation"].get<int>()), lowest_evaluation);
+    EXPECT_EQ(st["best"]["variables"]["d"].get<double>(), std::strtod(lowest_d.c_str(), nullptr));
+    EXPECT_FALSE(st["nlopt_result"].get<std::string>().empty());
+    EXPECT_FALSE(st["stop_reason"].get<std::string>().empty());
+    if (st["nlopt_result"] == "XTOL_REACHED") {
+      EXPECT_EQ(st["stop_reason"],
+                "a step changed every variable, scaled to [0, 1] by its bounds, by less than "
+                "xtol_rel (1e-10) of its value");
+    }
+    if (lowest < best_of_starts) best_of_starts = lowest;
+    if (st["start"] == best["start"]) {
+      EXPECT_EQ(st["best"]["evaluation"], best["evaluation"]);
+    }
+  }
+  EXPECT_EQ(best["objective"].get<double>(), best_of_starts);
 }
 
 // --- 2. Sweep rows equal single runs ------------------------------------------------------------

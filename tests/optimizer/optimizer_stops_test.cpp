@@ -208,8 +208,20 @@ TEST_F(OptimizerStops, AnNloptFailureFailsTheStudy) {
   EXPECT_FALSE(fs::exists(dir_ / "out" / "best.json"));
   EXPECT_FALSE(fs::exists(dir_ / "out" / "best_scene.json"));
   EXPECT_FALSE(summary.contains("best"));
-  // The start's stop in words, and the best feasible design it evaluated, given for information.
-  EXPECT_EQ(summary["starts"][0]["best"]["evaluation"], summary["best_evaluated"]["evaluation"]);
+  // The best feasible design it evaluated is given for information, with its constraint report,
+  // and the start's stop in words.
+  const Json& b = summary["best_evaluated"];
+  ASSERT_TRUE(b.is_object()) << summary.dump(2);
+  ASSERT_EQ(b["constraints"].size(), 1u);
+  const Json& c = b["constraints"][0];
+  EXPECT_EQ(c["response"], "f1");
+  EXPECT_EQ(c["type"], ">=");
+  EXPECT_EQ(c["bound"], 20.0);
+  EXPECT_EQ(c["value"], b["responses"]["f1"]);
+  EXPECT_DOUBLE_EQ(c["margin"].get<double>(), c["value"].get<double>() - 20.0);
+  EXPECT_DOUBLE_EQ(c["relative_margin"].get<double>(), c["margin"].get<double>() / 20.0);
+  EXPECT_EQ(c["satisfied"], true);
+  EXPECT_EQ(summary["starts"][0]["best"]["evaluation"], b["evaluation"]);
   EXPECT_TRUE(contains(summary["starts"][0]["stop_reason"], "NLopt failed")) << summary["starts"];
 }
 

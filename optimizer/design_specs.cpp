@@ -206,8 +206,10 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
         p.goal = minimize ? OptimizePlan::Goal::kMinimize : OptimizePlan::Goal::kMaximize;
         const std::string key = minimize ? "minimize" : "maximize";
         p.response = response_named(o, key, minimize ? *minimize : *maximize, study).value_or(0);
+        p.objective_scale = o.positive("scale", false);
       } else {
         p.goal = OptimizePlan::Goal::kTarget;
+        p.objective_scale = o.positive("scale", false);
         ObjectReader t(*target, o.at("target"), r.diagnostics());
         if (t.is_object()) {
           if (target->empty()) o.error("target", "expected at least one response: value");
@@ -241,6 +243,7 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
         c.error("response", "give exactly one of \">=\", \"<=\" or \"abs<=\" with a bound");
         continue;
       }
+      con.scale = c.positive("scale", false);
       if (!name) continue;
       if (const auto k = response_named(c, "response", *name, study)) {
         con.response = *k;
@@ -276,6 +279,8 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
   p.starts = static_cast<int>(std::min(r.integer("starts", false, 1).value_or(1), 100000L));
   p.seed = static_cast<unsigned long>(r.integer("seed", false, 0).value_or(1));
   p.gradient_step = r.positive("gradient_step", false).value_or(p.gradient_step);
+  if (const auto g = r.choice("gradient", false, {"exact", "fd"}))
+    p.gradient = *g == "fd" ? OptimizePlan::Gradient::kDifferences : OptimizePlan::Gradient::kExact;
   if (const auto w = r.choice("warned_designs", false, {"infeasible", "accept"}))
     p.warned_designs = *w == "accept" ? OptimizePlan::WarnedDesigns::kAccept
                                       : OptimizePlan::WarnedDesigns::kInfeasible;
@@ -356,6 +361,7 @@ std::optional<DesignStudy> read_design_study(const Json& value, const Where& whe
                "max_seconds",
                "starts",
                "gradient_step",
+               "gradient",
                "methods",
                "rtols",
                "atol_scale",

@@ -38,6 +38,9 @@ struct Constraint {
   int response = 0;                                   // index into study.responses
   Kind kind = Kind::kAtLeast;
   double bound = 0.0;
+  // NLopt sees (value - bound) / scale (signed so that <= 0 is met): given, or |bound|, or for a
+  // bound of 0 the constraint's magnitude at the first start's design (1 when that is 0 too).
+  std::optional<double> scale;
 };
 
 struct OptimizePlan {
@@ -52,7 +55,13 @@ struct OptimizePlan {
   double xtol_rel = 1e-6, ftol_rel = 0.0, max_seconds = 0.0;
   int starts = 1;
   unsigned long seed = 1;
+  // Gradients of LD_ algorithms: the exact design sensitivities (optimizer/sensitivities.hpp;
+  // central differences for a design that has none, with a warning), or central differences.
+  enum class Gradient { kExact, kDifferences };
+  Gradient gradient = Gradient::kExact;
   double gradient_step = 1e-6;  // central differences: h = step * (upper - lower)
+  // NLopt sees the objective divided by this: given, or |objective| at each start's first design.
+  std::optional<double> objective_scale;
   // A design whose analyses gave warnings (the model's assumptions strained: large element
   // rotations, a rail at its min_length, ...): counted as infeasible (as a failed design: the
   // optimizer sees the penalty, and it is never the best) or accepted like any other.

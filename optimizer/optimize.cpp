@@ -1,6 +1,7 @@
 #include "optimizer/optimize.hpp"
 
 #include <nlopt.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <atomic>
@@ -109,19 +110,35 @@ class Optimization {
   // The outcomes of designs xs for a start, evaluated in parallel where new, recorded in order.
   // A call is evaluated whole or not at all: nullopt (nothing evaluated, NLopt told to stop) when
   // the designs new to the start would take it beyond its budget of max_evaluations designs.
+  // With `sensitivities`, new designs are evaluated with their exact derivatives (jacobians_).
   std::optional<std::vector<DesignOutcome>> outcomes(Start& start, const std::vector<Design>& xs,
-                                                     bool parallel);
-  // Value and (when grad != nullptr) central-difference gradient of f(outcome) at x.
-  template <class F>
-  double value_and_gradient(Start& start, const double* x, double* grad, F&& f);
+                                                     bool parallel, bool sensitivities);
+  // The outcome of x with the derivatives of its responses (null when it has none: the reason is
+  // counted); nullopt beyond the start's design budget.
+  std::optional<std::pair<DesignOutcome, std::shared_ptr<const Eigen::MatrixXd>>> with_derivatives(
+      Start& start, const Design& x);
 
-  // NLopt's view: scaled variables s in [0, 1]^n (scaled_variable) and the objective divided by
-  // the start's objective_scale; f(outcome) -> the value, gradient by the chain rule.
-  template <class F>
-  double scaled_value(Start& start, const double* s, double* grad, double scale, F&& f);
+  // What NLopt minimizes or bounds: which = -1 the objective, j >= 0 constraint j (as
+  // constraint_of); kPenalty for a design that is not usable.
+  double value_of(const DesignOutcome& o, int which) const;
+  // d value_of / d responses; false when there is none (a penalty).
+  bool partials_of(const DesignOutcome& o, int which, Eigen::VectorXd& d) const;
+  // Value and (when grad != nullptr) gradient of value_of(outcome, which) at x: exact (the design
+  // sensitivities) or by differences inside the bounds (central, or second-order one-sided at a
+  // bound).
+  double value_and_gradient(Start& start, const double* x, double* grad, int which);
+
+  // NLopt's view: scaled variables s in [0, 1]^n (scaled_variable) and the value divided by
+  // `scale`; gradient by the chain rule.
+  double scaled_value(Start& start, const double* s, double* grad, double scale, int which);
   static double objective_callback(unsigned n, const double* x, double* grad, void* data);
   static double constraint_callback(unsigned n, const double* x, double* grad, void* data);
 
+  // Whether NLopt's gradients are the design sensitivities.
+  bool exact_gradients() const {
+    return needs_gradient(plan_.algorithm) && plan_.gradient == OptimizePlan::Gradient::kExact;
+  }
+  void record_derivatives(const Design& x, const DesignOutcome& o, ResponseSensitivities& s);
   void run_start(Start& start, const Design& x0);
   std::vector<Design> start_points() const;
   CsvRow row(const Record& r) const;
@@ -137,6 +154,13 @@ class Optimization {
   Progress progress_;
   BatchTable history_;
   std::map<Design, DesignOutcome> cache_;  // every design evaluated, this run or before
+  // The exact derivatives of the designs evaluated with them (null: none, see gradient_fallbacks_)
+  std::map<Design, std::shared_ptr<const Eigen::MatrixXd>> jacobians_;
+  long exact_gradients_ = 0, gradient_fallbacks_ = 0;  // under mutex_
+  std::string fallback_reason_;                        // the first design's
+  std::set<std::string> sensitivity_warnings_;
+  // NLopt sees constraint j as (violation in the response's units) / constraint_scales_[j]
+  std::vector<double> constraint_scales_;
   std::vector<Record> records_;
   std::mutex mutex_;
   std::atomic<long> simulated_{0}, failures_{0};
@@ -272,8 +296,10 @@ void Optimization::show_progress() {
 
 std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
                                                                  const std::vector<Design>& xs,
-                                                                 bool parallel) {
+                                                                 bool parallel,
+                                                                 bool sensitivities) {
   std::vector<DesignOutcome> out(xs.size());
+  std::vector<ResponseSensitivities> derivatives(sensitivities ? xs.size() : 0);
   std::vector<char> known(xs.size(), 0);
   std::vector<int> numbers(xs.size());
   {
@@ -303,6 +329,13 @@ std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
       }
     }
   }
+  // A design listed twice (a difference point clamped onto the point) is evaluated once.
+  std::map<Design, long> first;
+  std::vector<long> copy_of(xs.size(), -1);
+  for (size_t i = 0; i < xs.size(); ++i) {
+    const auto [it, is_new] = first.try_emplace(xs[i], static_cast<long>(i));
+    if (!is_new && !known[i]) copy_of[i] = it->second, known[i] = 1;
+  }
   const long n = static_cast<long>(xs.size());
   const int threads = static_cast<int>(std::min<long>(threads_, n));
 #pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1) num_threads(threads)
@@ -313,13 +346,15 @@ std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
         out[i].responses.assign(study_.responses.size(), kNaN);
         continue;
       }
-      out[i] = evaluator_.evaluate(xs[i]);
+      out[i] = evaluator_.evaluate(xs[i], sensitivities ? &derivatives[i] : nullptr);
       if (out[i].status == "interrupted") continue;
       ++simulated_;
       if (out[i].status != "ok") ++failures_;
       if (numbers[i] > 0) ++done_;
       show_progress();
     }
+  for (size_t i = 0; i < xs.size(); ++i)
+    if (copy_of[i] >= 0) out[i] = out[copy_of[i]];
   {
     std::lock_guard<std::mutex> lock(mutex_);
     for (size_t i = 0; i < xs.size(); ++i) {
@@ -327,6 +362,7 @@ std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
       // evaluates it).
       if (out[i].status == "interrupted") continue;
       cache_.try_emplace(xs[i], out[i]);
+      if (sensitivities && !known[i]) record_derivatives(xs[i], out[i], derivatives[i]);
       if (numbers[i] < 0) continue;
       Record r{start.index, numbers[i], xs[i], out[i], objective_of(out[i]), feasible(out[i])};
       if (!history_.append(row(r))) write_failed_ = true;
@@ -341,53 +377,156 @@ std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
   return out;
 }
 
-template <class F>
-double Optimization::value_and_gradient(Start& start, const double* x, double* grad, F&& f) {
+void Optimization::record_derivatives(const Design& x, const DesignOutcome& o,
+                                      ResponseSensitivities& s) {
+  // Under mutex_.
+  if (s.ok) {
+    ++exact_gradients_;
+    jacobians_[x] = std::make_shared<const Eigen::MatrixXd>(std::move(s.jacobian));
+    for (std::string& w : s.warnings)
+      if (sensitivity_warnings_.size() < 20) sensitivity_warnings_.insert(std::move(w));
+  } else {
+    jacobians_[x] = nullptr;
+    if (o.status != "ok") return;  // a failed design is a penalty: no gradient needed
+    ++gradient_fallbacks_;
+    if (fallback_reason_.empty()) fallback_reason_ = s.message;
+  }
+}
+
+std::optional<std::pair<DesignOutcome, std::shared_ptr<const Eigen::MatrixXd>>>
+Optimization::with_derivatives(Start& start, const Design& x) {
+  const auto o = outcomes(start, {x}, false, true);
+  if (!o) return std::nullopt;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = jacobians_.find(x);
+    if (it != jacobians_.end()) return std::make_pair((*o)[0], it->second);
+  }
+  // Evaluated before without its derivatives (another start's difference point, or history.csv
+  // on --resume): once more, with them; no new row.
+  ResponseSensitivities s;
+  const DesignOutcome again = evaluator_.evaluate(x, &s);
+  if (again.status == "interrupted") return std::make_pair((*o)[0], nullptr);
+  ++simulated_;
+  std::lock_guard<std::mutex> lock(mutex_);
+  record_derivatives(x, again, s);
+  return std::make_pair((*o)[0], jacobians_[x]);
+}
+
+double Optimization::value_of(const DesignOutcome& o, int which) const {
+  return which < 0 ? objective_of(o) : constraint_of(o, which);
+}
+
+bool Optimization::partials_of(const DesignOutcome& o, int which, Eigen::VectorXd& d) const {
+  if (value_of(o, which) >= kPenalty) return false;
+  d = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(study_.responses.size()));
+  if (which < 0) {
+    switch (plan_.goal) {
+      case OptimizePlan::Goal::kMinimize:
+        d(plan_.response) = 1.0;
+        break;
+      case OptimizePlan::Goal::kMaximize:
+        d(plan_.response) = -1.0;
+        break;
+      case OptimizePlan::Goal::kTarget:
+        for (const auto& [k, t] : plan_.targets) {
+          const double scale = t != 0.0 ? std::abs(t) : 1.0;
+          d(k) += 2.0 * (o.responses[k] - t) / (scale * scale);
+        }
+        break;
+    }
+    return true;
+  }
+  const Constraint& c = plan_.constraints[which];
+  const double scale = c.bound != 0.0 ? std::abs(c.bound) : 1.0;  // as constraint_of
+  const double r = o.responses[c.response];
+  d(c.response) = c.kind == Constraint::Kind::kAtLeast  ? -1.0 / scale
+                  : c.kind == Constraint::Kind::kAtMost ? 1.0 / scale
+                                                        : (r < 0.0 ? -1.0 : 1.0) / scale;
+  return true;
+}
+
+double Optimization::value_and_gradient(Start& start, const double* x, double* grad, int which) {
   const size_t n = variables_.size();
   const Design x0(x, x + n);
+  if (grad && plan_.gradient == OptimizePlan::Gradient::kExact) {
+    const auto r = with_derivatives(start, x0);
+    if (!r) {  // beyond the start's design budget: nothing evaluated, NLopt stops
+      std::fill(grad, grad + n, 0.0);
+      return kPenalty;
+    }
+    const double value = value_of(r->first, which);
+    Eigen::VectorXd d;
+    if (value >= kPenalty || !partials_of(r->first, which, d)) {
+      std::fill(grad, grad + n, 0.0);
+      return value;
+    }
+    if (r->second) {
+      const Eigen::MatrixXd& jacobian = *r->second;
+      bool finite = true;
+      for (size_t i = 0; i < n; ++i) {
+        grad[i] = 0.0;
+        for (Eigen::Index k = 0; k < d.size(); ++k)
+          if (d(k) != 0.0) grad[i] += d(k) * jacobian(k, static_cast<Eigen::Index>(i));
+        finite = finite && std::isfinite(grad[i]);
+      }
+      if (finite) return value;
+    }
+    // No exact derivatives for this design: differences.
+  }
+  // Difference points inside the bounds: central where x0 +- h fit, else second-order one-sided
+  // (x0 -+ h, x0 -+ 2h) at a bound.
+  enum class Stencil { kCentral, kBackward, kForward };
   std::vector<Design> points{x0};
   std::vector<double> h(n, 0.0);
+  std::vector<Stencil> stencil(n, Stencil::kCentral);
   if (grad) {
     for (size_t i = 0; i < n; ++i) {
-      h[i] = plan_.gradient_step * (variables_[i].upper - variables_[i].lower);
-      Design up = x0, down = x0;
-      up[i] = std::min(x0[i] + h[i], variables_[i].upper);
-      down[i] = std::max(x0[i] - h[i], variables_[i].lower);
-      points.push_back(up);
-      points.push_back(down);
+      const DesignVariable& v = variables_[i];
+      h[i] = plan_.gradient_step * (v.upper - v.lower);
+      const bool up = x0[i] + h[i] <= v.upper, down = x0[i] - h[i] >= v.lower;
+      stencil[i] = up && down ? Stencil::kCentral : up ? Stencil::kForward : Stencil::kBackward;
+      const double s1 = stencil[i] == Stencil::kBackward ? -h[i] : h[i];
+      const double s2 = stencil[i] == Stencil::kCentral ? -h[i] : 2.0 * s1;
+      Design a = x0, b = x0;
+      a[i] = std::clamp(x0[i] + s1, v.lower, v.upper);
+      b[i] = std::clamp(x0[i] + s2, v.lower, v.upper);
+      points.push_back(a);
+      points.push_back(b);
     }
   }
-  const std::optional<std::vector<DesignOutcome>> evaluated = outcomes(start, points, true);
+  const std::optional<std::vector<DesignOutcome>> evaluated = outcomes(start, points, true, false);
   if (!evaluated) {  // beyond the start's design budget: nothing evaluated, NLopt stops
     if (grad) std::fill(grad, grad + n, 0.0);
     return kPenalty;
   }
   const std::vector<DesignOutcome>& o = *evaluated;
-  const double value = f(o[0]);
+  const double value = value_of(o[0], which);
   if (grad)
     for (size_t i = 0; i < n; ++i) {
-      const double fu = f(o[1 + 2 * i]), fd = f(o[2 + 2 * i]);
-      const double xu = points[1 + 2 * i][i], xd = points[2 + 2 * i][i];
-      if (fu < kPenalty && fd < kPenalty)
-        grad[i] = (fu - fd) / (xu - xd);
-      else if (fu < kPenalty && value < kPenalty && xu != x0[i])
-        grad[i] = (fu - value) / (xu - x0[i]);
-      else if (fd < kPenalty && value < kPenalty && xd != x0[i])
-        grad[i] = (value - fd) / (x0[i] - xd);
-      else
-        grad[i] = 0.0;
+      const double fa = value_of(o[1 + 2 * i], which), fb = value_of(o[2 + 2 * i], which);
+      const double a = points[1 + 2 * i][i] - x0[i], b = points[2 + 2 * i][i] - x0[i];
+      grad[i] = 0.0;
+      if (stencil[i] == Stencil::kCentral && fa < kPenalty && fb < kPenalty && a != b)
+        grad[i] = (fa - fb) / (a - b);
+      else if (stencil[i] != Stencil::kCentral && value < kPenalty && fa < kPenalty &&
+               fb < kPenalty && a != 0.0 && b == 2.0 * a)
+        grad[i] = (-3.0 * value + 4.0 * fa - fb) / (2.0 * a);  // a = +-h, b = +-2h
+      else if (fa < kPenalty && value < kPenalty && a != 0.0)
+        grad[i] = (fa - value) / a;
+      else if (fb < kPenalty && value < kPenalty && b != 0.0)
+        grad[i] = (fb - value) / b;
     }
   return value;
 }
 
-template <class F>
 double Optimization::scaled_value(Start& start, const double* s, double* grad, double scale,
-                                  F&& f) {
+                                  int which) {
   const size_t n = variables_.size();
   Design x(n);
   for (size_t i = 0; i < n; ++i) x[i] = physical_variable(variables_[i], s[i]);
   std::vector<double> gx(n, 0.0);
-  const double v = value_and_gradient(start, x.data(), grad ? gx.data() : nullptr, f);
+  const double v = value_and_gradient(start, x.data(), grad ? gx.data() : nullptr, which);
   if (grad)
     for (size_t i = 0; i < n; ++i)
       grad[i] = gx[i] * (variables_[i].upper - variables_[i].lower) / scale;
@@ -399,9 +538,7 @@ double Optimization::objective_callback(unsigned, const double* x, double* grad,
   try {
     ++start->nlopt_evaluations;
     Optimization& self = *start->self;
-    const double v =
-        self.scaled_value(*start, x, grad, start->objective_scale,
-                          [&](const DesignOutcome& o) { return self.objective_of(o); });
+    const double v = self.scaled_value(*start, x, grad, start->objective_scale, -1);
     if (must_stop(self.write_failed_)) {
       start->stopped = true;
       nlopt_force_stop(start->opt);
@@ -417,8 +554,11 @@ double Optimization::constraint_callback(unsigned, const double* x, double* grad
   try {
     Optimization& self = *ref->start->self;
     const int j = ref->j;
-    return self.scaled_value(*ref->start, x, grad, 1.0,
-                             [&](const DesignOutcome& o) { return self.constraint_of(o, j); });
+    // constraint_of is relative to |bound| (or 1): NLopt sees it relative to the constraint's
+    // scale.
+    const Constraint& c = self.plan_.constraints[j];
+    const double relative_to = c.bound != 0.0 ? std::abs(c.bound) : 1.0;
+    return self.scaled_value(*ref->start, x, grad, self.constraint_scales_[j] / relative_to, j);
   } catch (...) {
     return kPenalty;
   }
@@ -458,9 +598,11 @@ void Optimization::run_start(Start& start, const Design& x0) {
 
   // The objective's scale: its magnitude at the start point (constraints are already relative to
   // their bounds).
-  const std::optional<std::vector<DesignOutcome>> o0 = outcomes(start, {x0}, false);
+  const std::optional<std::vector<DesignOutcome>> o0 =
+      outcomes(start, {x0}, false, exact_gradients());
   const double f0 = o0 ? objective_of((*o0)[0]) : kPenalty;
-  start.objective_scale = f0 < kPenalty && std::abs(f0) > 0.0 ? std::abs(f0) : 1.0;
+  start.objective_scale =
+      plan_.objective_scale.value_or(f0 < kPenalty && std::abs(f0) > 0.0 ? std::abs(f0) : 1.0);
   Design x(x0.size());
   for (size_t i = 0; i < x0.size(); ++i) x[i] = scaled_variable(variables_[i], x0[i]);
   double f = 0.0;
@@ -556,6 +698,12 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
     if (!m.error.empty()) errors.push_back(m.error);
     stopped = stopped || st.stopped;
   }
+  if (gradient_fallbacks_ > 0)
+    warnings.push_back(std::to_string(gradient_fallbacks_) +
+                       " design(s) had no exact derivatives, and their gradients came from "
+                       "central differences: " +
+                       fallback_reason_);
+  for (const std::string& w : sensitivity_warnings_) warnings.push_back("derivatives: " + w);
   const bool interrupted = signal != 0 && stopped;
   std::string status, message;
   if (!history_error.empty()) {
@@ -614,6 +762,37 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
                          {"best", start_best}});
   }
   s["starts"] = per_start;
+  // The problem NLopt sees.
+  nlohmann::json scaling;
+  nlohmann::json vars = nlohmann::json::array(), cons = nlohmann::json::array();
+  for (const DesignVariable& v : variables_)
+    vars.push_back({{"name", v.name}, {"lower", v.lower}, {"upper", v.upper}});
+  for (size_t j = 0; j < plan_.constraints.size(); ++j)
+    cons.push_back({{"response", study_.responses[plan_.constraints[j].response].name},
+                    {"scale", constraint_scales_.at(j)}});
+  nlohmann::json objective_scales = nlohmann::json::array();
+  for (const Start& st : starts) objective_scales.push_back(st.objective_scale);
+  scaling["variables"] = vars;
+  scaling["variables_seen_as"] = "(x - lower) / (upper - lower), in [0, 1]";
+  scaling["objective_scale"] = objective_scales;
+  scaling["objective_seen_as"] = "objective / objective_scale (per start)";
+  scaling["constraints"] = cons;
+  scaling["constraints_seen_as"] =
+      "violation in the response's units / scale, <= 0 when met (value - bound for <=, bound - "
+      "value for >=, |value| - bound for abs<=)";
+  s["scaling"] = scaling;
+  if (needs_gradient(plan_.algorithm)) {
+    nlohmann::json g;
+    g["method"] = exact_gradients() ? "exact" : "fd";
+    if (exact_gradients()) {
+      g["designs_with_exact_derivatives"] = exact_gradients_;
+      g["designs_by_differences"] = gradient_fallbacks_;
+      if (gradient_fallbacks_ > 0) g["why_differences"] = fallback_reason_;
+    } else {
+      g["step"] = plan_.gradient_step;
+    }
+    s["gradient"] = g;
+  }
   s["designs_simulated"] = simulated_.load();
   s["designs_failed"] = failures_.load();
   long warned = 0;
@@ -734,15 +913,34 @@ int Optimization::run() {
 
   const std::vector<Design> points = start_points();
   // Designs evaluated at once: the starts, or the central-difference points of one gradient.
+  // Designs evaluated at once: the starts, the central-difference points of one gradient, or
+  // the variables whose derivatives one design's sensitivities compute in parallel.
+  const long n_variables = static_cast<long>(variables_.size());
   const long at_once =
-      std::max(static_cast<long>(points.size()),
-               needs_gradient(plan_.algorithm) ? 2 * static_cast<long>(variables_.size()) + 1 : 1);
+      std::max(static_cast<long>(points.size()), !needs_gradient(plan_.algorithm) ? 1
+                                                 : exact_gradients()              ? n_variables
+                                                                     : 2 * n_variables + 1);
   threads_ = batch_threads(settings_, at_once);
+  omp_set_num_threads(threads_);  // the sensitivities' parallel loops (one thread inside a start)
   budget_total_ = static_cast<long>(plan_.max_evaluations) * static_cast<long>(points.size());
   progress_.set_total(budget_total_);
   std::vector<Start> starts(points.size());
   for (size_t s = 0; s < points.size(); ++s)
     starts[s].self = this, starts[s].index = static_cast<int>(s) + 1;
+  // The constraints' scales: given, or |bound|, or for a bound of 0 the response's magnitude at
+  // the first start's design (evaluated now; the start finds it done).
+  const std::optional<std::vector<DesignOutcome>> first =
+      points.empty() ? std::nullopt : outcomes(starts[0], {points[0]}, false, exact_gradients());
+  for (const Constraint& c : plan_.constraints) {
+    double scale = std::abs(c.bound);
+    if (c.scale) {
+      scale = *c.scale;
+    } else if (c.bound == 0.0) {
+      const double r = first ? std::abs((*first)[0].responses[c.response]) : 0.0;
+      scale = std::isfinite(r) && r > 0.0 ? r : 1.0;
+    }
+    constraint_scales_.push_back(scale);
+  }
   const int n_starts = static_cast<int>(points.size());
 #pragma omp parallel for schedule(dynamic, 1) if (n_starts > 1) \
     num_threads(std::min(threads_, n_starts))

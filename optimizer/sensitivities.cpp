@@ -36,7 +36,8 @@ class Sensitivities {
                             const std::vector<const Study*>& minus, const std::vector<double>& h);
 
  private:
-  // Fills column j of out.jacobian; false (with out.message) when it cannot.
+  // Fills the single column of out.jacobian with the derivatives along variable j; false (with
+  // out.message) when it cannot.
   bool variable(int j, const Study& plus, const Study& minus, double h, ResponseSensitivities& out);
 
   const Study& design_;
@@ -85,11 +86,24 @@ ResponseSensitivities Sensitivities::run(const std::vector<const Study*>& plus,
     auto s = std::make_unique<EquilibriumSensitivity>(*e.model, *e.data, e.time, 1.0);
     equilibria_.emplace(key, std::move(s));
   }
-  for (int j = 0; j < nv; ++j)
-    if (!variable(j, *plus[j], *minus[j], h[j], out)) {
+  // The variables in parallel (each writes its own column, warnings and message); one thread
+  // when already inside a parallel batch.
+  std::vector<ResponseSensitivities> per(nv);
+  std::vector<char> done(nv, 0);
+#pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
+  for (int j = 0; j < nv; ++j) {
+    per[j].jacobian = Eigen::MatrixXd::Constant(nr, 1, kNaN);
+    done[j] = variable(j, *plus[j], *minus[j], h[j], per[j]);
+  }
+  for (int j = 0; j < nv; ++j) {
+    if (!done[j]) {
+      out.message = per[j].message;
       out.jacobian.setConstant(kNaN);
       return out;
     }
+    out.jacobian.col(j) = per[j].jacobian.col(0);
+    for (std::string& w : per[j].warnings) out.warnings.push_back(std::move(w));
+  }
   chain_expression_derivatives(design_, ev_.responses, out.jacobian);
   for (int k = 0; k < nr; ++k)
     if (std::isnan(ev_.responses[k])) out.jacobian.row(k).setConstant(kNaN);
@@ -107,7 +121,7 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
   }
   const EvaluationStates& states = *ev_.states;
   const int nr = static_cast<int>(design_.responses.size());
-  auto column = out.jacobian.col(j);
+  auto column = out.jacobian.col(0);
 
   // du/dp of each equilibrium, on its load case's models.
   std::map<std::string, Eigen::VectorXd> v;

@@ -1,5 +1,7 @@
 #include "optimizer/sensitivity_study.hpp"
 
+#include <omp.h>
+
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -26,6 +28,9 @@ int run_sensitivity(const Study& study, const RunSettings& settings) {
     return fail_before_designs(study, settings.output, "sensitivity", evaluator.setup_failure());
   std::vector<double> x;
   for (const DesignVariable& v : plan.variables) x.push_back(v.value);
+  // The variables' derivatives are computed in parallel.
+  const int threads = batch_threads(settings, static_cast<long>(x.size()));
+  omp_set_num_threads(threads);
 
   ResponseSensitivities s;
   const DesignOutcome design = evaluator.evaluate(x, &s);
@@ -112,6 +117,7 @@ int run_sensitivity(const Study& study, const RunSettings& settings) {
   summary["variables"] = variables;
   summary["responses"] = responses;
   summary["design_seconds"] = design_seconds;
+  summary["threads"] = threads;
   if (plan.sensitivity.check) {
     summary["check_seconds"] = check_seconds;
     summary["check_step"] = plan.sensitivity.check_step;

@@ -10,8 +10,10 @@ namespace beamrail {
 
 DesignEvaluator::DesignEvaluator(const Study& study) : study_(study), base_(study.document) {
   base_.erase("study");
-  for (const DesignVariable& v : study.design->variables)
+  for (const DesignVariable& v : study.design->variables) {
     pointers_.emplace_back(v.pointers.begin(), v.pointers.end());
+    for (const std::string& p : v.pointers) scene_only_ = scene_only_ && p.rfind("/scene/", 0) == 0;
+  }
   bool tracked = false;
   for (const ResponseSpec& r : study.responses) tracked = tracked || r.track;
   if (!tracked) return;
@@ -68,7 +70,7 @@ ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& 
     at[j] += (i % 2 == 0 ? 1.0 : -1.0) * h[j];
     Diagnostics diag;
     auto& out = i % 2 == 0 ? plus[j] : minus[j];
-    out = load_study(document(at), study_.file, study_.directory, diag);
+    out = build(at, diag);
     if (!out) invalid[i] = problems(diag);
   }
   for (int i = 0; i < 2 * nv; ++i)
@@ -84,6 +86,31 @@ ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& 
   return response_sensitivities(design, ev, p, m, h);
 }
 
+std::optional<Study> DesignEvaluator::build(const std::vector<double>& x, Diagnostics& diag) const {
+  if (scene_only_) {
+    std::unique_ptr<Json> doc;
+    {
+      std::lock_guard<std::mutex> lock(pool_mutex_);
+      if (!pool_.empty()) doc = std::move(pool_.back()), pool_.pop_back();
+    }
+    if (!doc) doc = std::make_unique<Json>(base_);
+    // Every variable's numbers are written: what an earlier design wrote is overwritten.
+    const auto& variables = study_.design->variables;
+    for (size_t i = 0; i < pointers_.size(); ++i)
+      for (size_t k = 0; k < pointers_[i].size(); ++k)
+        (*doc)[pointers_[i][k]] = variables[i].factors[k] * x[i] + variables[i].offsets[k];
+    bool full = false;
+    auto s = rebuild_scene(study_, *doc, diag, &full);
+    {
+      std::lock_guard<std::mutex> lock(pool_mutex_);
+      pool_.push_back(std::move(doc));
+    }
+    if (s || !full) return s;
+    diag = Diagnostics();
+  }
+  return load_study(document(x), study_.file, study_.directory, diag);
+}
+
 DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,
                                         ResponseSensitivities* sensitivities) const {
   const auto start = std::chrono::steady_clock::now();
@@ -91,7 +118,7 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,
   out.responses.assign(study_.responses.size(), std::numeric_limits<double>::quiet_NaN());
   try {
     Diagnostics diag;
-    const auto design = load_study(document(x), study_.file, study_.directory, diag);
+    const auto design = build(x, diag);
     if (!design) {
       // The first problem names what the values broke (zero-length beam, point on the axis...).
       out.status = "invalid";

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,11 @@ class DesignEvaluator {
   // `beamrail run` runs as is.
   Json document(const std::vector<double>& x) const;
 
+  // The study of the design x: its scene rebuilt from the numbers when every variable addresses the
+  // scene (rebuild_scene), else the whole document read again. nullopt when x breaks the study
+  // (the problems in diag).
+  std::optional<Study> build(const std::vector<double>& x, Diagnostics& diag) const;
+
   const Study& study() const { return study_; }
   // The structures analysed for, and reused by, the evaluations so far.
   const SparseStructureCache& structures() const { return *structures_; }
@@ -59,7 +65,12 @@ class DesignEvaluator {
   Json base_;                                              // study.document without "study"
   std::vector<std::vector<Json::json_pointer>> pointers_;  // per variable
   std::shared_ptr<SparseStructureCache> structures_ = std::make_shared<SparseStructureCache>();
-  ModeShapes references_;  // of tracked frequency responses
+  ModeShapes references_;   // of tracked frequency responses
+  bool scene_only_ = true;  // every variable addresses a number of the scene
+  // Copies of the study document that designs' values are written into (one per evaluation under
+  // way, reused: no document is copied per design).
+  mutable std::mutex pool_mutex_;
+  mutable std::vector<std::unique_ptr<Json>> pool_;
   std::string setup_failure_;
 };
 

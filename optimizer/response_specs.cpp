@@ -268,6 +268,7 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
     s.analysis = *analysis;
     s.body = *body;
     s.point = point.value_or(model->bodies[*body].position);
+    s.point_given = point.has_value();
     s.direction = *direction;
     return s;
   }

@@ -192,6 +192,63 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
   return study;
 }
 
+namespace {
+
+bool same_structure(const Model& a, const Model& b) {
+  if (a.bodies.size() != b.bodies.size() || a.beams.size() != b.beams.size() ||
+      a.rails.size() != b.rails.size() || a.loads.size() != b.loads.size() ||
+      a.free_bodies != b.free_bodies || a.load_cases != b.load_cases ||
+      (a.gravity.norm() > 0.0) != (b.gravity.norm() > 0.0))
+    return false;
+  for (size_t i = 0; i < a.bodies.size(); ++i)
+    if (a.bodies[i].name != b.bodies[i].name) return false;
+  for (size_t i = 0; i < a.beams.size(); ++i)
+    if (a.beams[i].name != b.beams[i].name) return false;
+  for (size_t i = 0; i < a.rails.size(); ++i)
+    if (a.rails[i].name != b.rails[i].name) return false;
+  for (size_t i = 0; i < a.loads.size(); ++i)
+    if (a.loads[i].body != b.loads[i].body || a.loads[i].kind != b.loads[i].kind ||
+        a.loads[i].load_case != b.loads[i].load_case)
+      return false;
+  return true;
+}
+
+}  // namespace
+
+std::optional<Study> rebuild_scene(const Study& base, const Json& document, Diagnostics& diag,
+                                   bool* full_read_needed) {
+  *full_read_needed = false;
+  const auto it = document.is_object() ? document.find("scene") : document.end();
+  const Json* scene = it != document.end() ? &*it : nullptr;
+  if (!scene || !scene->is_object()) {
+    *full_read_needed = true;
+    return std::nullopt;
+  }
+  const size_t warnings_before = diag.warning_lines().size();
+  auto model = load_scene(*scene, Where{base.file, ""} / "scene", diag);
+  if (!model) return std::nullopt;
+  if (!same_structure(*model, base.model)) {
+    *full_read_needed = true;
+    return std::nullopt;
+  }
+  Study s;
+  s.file = base.file;
+  s.directory = base.directory;
+  s.name = base.name;
+  s.description = base.description;
+  s.analyses = base.analyses;
+  s.responses = base.responses;
+  s.expression_order = base.expression_order;
+  s.model = std::move(*model);
+  for (ResponseSpec& r : s.responses)
+    if (!r.point_given && r.quantity != ResponseSpec::Quantity::kMass &&
+        r.quantity != ResponseSpec::Quantity::kExpression)
+      r.point = s.model.bodies[r.body].position;
+  const std::vector<std::string> lines = diag.warning_lines();
+  s.input_warnings.assign(lines.begin() + static_cast<long>(warnings_before), lines.end());
+  return s;
+}
+
 std::optional<Study> load_study_file(const std::string& path, Diagnostics& diag) {
   const size_t errors_before = diag.size();
   const auto document = read_json_file(path, path, diag);

@@ -77,6 +77,7 @@ struct ResponseSpec {
   int dominant = -1;
   int body = 0;                    // displacement-like quantities: body index
   Vec3 point = Vec3::Zero();       // global point in the initial configuration [m]
+  bool point_given = false;        // false: the body's position (the point follows the body)
   Vec3 direction = Vec3::UnitX();  // unit vector, global (the axis of a rotation)
   ElementEnd element;              // element_force
   int component = 0;               // element_force: 0..5 = fx, fy, fz, mx, my, mz
@@ -113,6 +114,16 @@ std::optional<Study> load_study_file(const std::string& path, Diagnostics& diag)
 // studies this way). `file` names the source in messages; `directory` resolves relative paths.
 std::optional<Study> load_study(const Json& document, const std::string& file,
                                 const std::filesystem::path& directory, Diagnostics& diag);
+
+// The study `base` with the document `document`, which differs from base.document in numbers of
+// its scene only (a design's values): its scene is built again, the rest (analyses, responses)
+// is taken from `base`, and what depends on scene numbers (a response's default point) follows.
+// The result keeps no document (a design's is its evaluator's to give). nullopt when the scene is
+// invalid (its problems in diag) or when the numbers change more than the Model's numbers (its
+// bodies, elements or loads, or whether gravity acts): then load_study must read the whole
+// document (*full_read_needed is set).
+std::optional<Study> rebuild_scene(const Study& base, const Json& document, Diagnostics& diag,
+                                   bool* full_read_needed);
 
 // The index of the first analysis of the given type, or -1.
 int find_analysis(const Study& study, AnalysisSpec::Type type);

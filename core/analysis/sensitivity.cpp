@@ -142,19 +142,20 @@ EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data
                                              double t, double load_factor,
                                              const std::vector<double>& lambdas,
                                              const Eigen::MatrixXd& shapes) {
-  using Sparse = Eigen::SparseMatrix<double>;
-  const auto matrices_at = [&](const Model& m, double sign, Sparse& k, Sparse& mass) {
+  // K Phi and M Phi at the states moved along the design direction, from the tangent's blocks.
+  const auto products_at = [&](const Model& m, double sign, Eigen::MatrixXd& k_phi,
+                               Eigen::MatrixXd& m_phi) {
     Data d = moved_state(base_model, base, m, scaled(v, sign * step.h));
     compute_wrenches(m, d, t, load_factor);
     compute_tangent(m, d, t, false, load_factor);
-    k = symmetric_stiffness(m, d, Eigen::VectorXd::Ones(m.n_dofs), nullptr);
-    mass = mass_matrix(m, d);
+    k_phi = symmetric_stiffness_product(m, d, shapes);
+    m_phi = mass_product(m, d, shapes);
   };
-  Sparse kp, mp, km, mm;
-  matrices_at(*step.plus, 1.0, kp, mp);
-  matrices_at(*step.minus, -1.0, km, mm);
-  const Eigen::MatrixXd dk_phi = Sparse((kp - km) / (2.0 * step.h)) * shapes;
-  const Eigen::MatrixXd dm_phi = Sparse((mp - mm) / (2.0 * step.h)) * shapes;
+  Eigen::MatrixXd kp, mp, km, mm;
+  products_at(*step.plus, 1.0, kp, mp);
+  products_at(*step.minus, -1.0, km, mm);
+  const Eigen::MatrixXd dk_phi = (kp - km) / (2.0 * step.h);
+  const Eigen::MatrixXd dm_phi = (mp - mm) / (2.0 * step.h);
   return cluster_derivatives(lambdas, [&](int first, int last, double mean) {
     const int size = last - first + 1;
     const auto phi = shapes.middleCols(first, size);

@@ -64,6 +64,33 @@ Eigen::VectorXd stiffness_weights(const Model& model, const Data& data) {
   return w;
 }
 
+Eigen::MatrixXd symmetric_stiffness_product(const Model& model, const Data& data,
+                                            const Eigen::MatrixXd& x) {
+  Eigen::MatrixXd y = Eigen::MatrixXd::Zero(x.rows(), x.cols());
+  for (size_t b = 0; b < model.pattern.blocks.size(); ++b) {
+    const int r0 = kDofsPerBody * model.pattern.blocks[b].row;
+    const int c0 = kDofsPerBody * model.pattern.blocks[b].col;
+    const Mat6& s = data.stiffness[b];
+    // K_rc = -(S_rc + S_cr^T) / 2: block b gives -S_b / 2 at (r, c) and -S_b^T / 2 at (c, r).
+    y.middleRows<6>(r0).noalias() -= 0.5 * s * x.middleRows<6>(c0);
+    y.middleRows<6>(c0).noalias() -= 0.5 * s.transpose() * x.middleRows<6>(r0);
+  }
+  return y;
+}
+
+Eigen::MatrixXd mass_product(const Model& model, const Data& data, const Eigen::MatrixXd& x) {
+  Eigen::MatrixXd y(x.rows(), x.cols());
+  for (int k = 0; k < model.n_free(); ++k) {
+    const int i = model.free_bodies[k];
+    const Body& b = model.bodies[i];
+    const Mat3 j = data.pose[i].A * b.inertia * data.pose[i].A.transpose();
+    const int o = kDofsPerBody * k;
+    y.middleRows<3>(o) = b.mass * x.middleRows<3>(o);
+    y.middleRows<3>(o + 3).noalias() = j * x.middleRows<3>(o + 3);
+  }
+  return y;
+}
+
 Eigen::SparseMatrix<double> mass_matrix(const Model& model, const Data& data) {
   std::vector<Eigen::Triplet<double>> entries;
   for (int k = 0; k < model.n_free(); ++k) {

@@ -32,6 +32,14 @@ Eigen::VectorXd stiffness_weights(const Model& model, const Data& data);
 // The mass matrix in these coordinates: blocks m I and A J A^T (n_dofs x n_dofs).
 Eigen::SparseMatrix<double> mass_matrix(const Model& model, const Data& data);
 
+// K X for the symmetric part K = -(S + S^T) / 2 of the tangent (as symmetric_stiffness) and a
+// block of vectors X (n_dofs x m), from the tangent's blocks without assembling K.
+Eigen::MatrixXd symmetric_stiffness_product(const Model& model, const Data& data,
+                                            const Eigen::MatrixXd& x);
+
+// M X, M the mass matrix (as mass_matrix), without assembling M.
+Eigen::MatrixXd mass_product(const Model& model, const Data& data, const Eigen::MatrixXd& x);
+
 // Moves the free bodies by dx: c += dc, q <- quat(dtheta) (x) q; updates pose (at rest) and the
 // bodies' rotation vectors (data.rotation, followed through pi).
 void apply_increment(const Model& model, Data& data, const Eigen::VectorXd& dx);

@@ -116,9 +116,19 @@ std::optional<double> read_number(const Json& value, const Where& where, Diagnos
   return x;
 }
 
+namespace {
+
+// A finite number: the common case, read without building the pointer a message would need.
+bool plain_number(const Json& value) {
+  return value.is_number() && std::isfinite(value.get<double>());
+}
+
+}  // namespace
+
 std::optional<double> ObjectReader::number(const std::string& key, bool required) {
   const Json* v = member(key, required);
   if (!v) return std::nullopt;
+  if (plain_number(*v)) return v->get<double>();
   return read_number(*v, at(key), diag_);
 }
 
@@ -190,7 +200,8 @@ std::optional<std::vector<double>> ObjectReader::numbers(const std::string& key,
   std::vector<double> out;
   bool ok = true;
   for (size_t i = 0; i < v->size(); ++i) {
-    const auto x = read_number((*v)[i], at(key) / i, diag_);
+    const auto x = plain_number((*v)[i]) ? std::optional<double>((*v)[i].get<double>())
+                                          : read_number((*v)[i], at(key) / i, diag_);
     ok = ok && x.has_value();
     out.push_back(x.value_or(0.0));
   }

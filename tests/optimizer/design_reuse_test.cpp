@@ -131,5 +131,38 @@ TEST(DesignReuse, StaticAnalysesShareTheStructureToo) {
   EXPECT_EQ(evaluator.structures().reuses(), 3);
 }
 
+// A design whose values change what the study reads from the scene beyond its numbers (gravity
+// switched off turns the modal analysis's default linearization from the static equilibrium to
+// the initial state) is read whole, not rebuilt from its scene: its responses equal its lone run's.
+TEST(DesignReuse, ValuesThatChangeTheAnalysesDefaultsReadTheWholeStudy) {
+  const std::string text = R"({"name": "gravity", "scene": {
+    "gravity": [0, 0, -9.81],
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "tip", "mass": 5, "inertia": [1e-3, 1e-3, 1e-3], "position": [1, 0, 0]}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq",
+               "segments": 3}]},
+  "analyses": [{"type": "modal", "modes": 2}],
+  "responses": {"f1": {"quantity": "frequency", "mode": 1}},
+  "study": {"type": "sweep", "sampling": "list", "rows": [[-9.81], [0], [-30]], "variables": [
+    {"name": "g", "pointer": "/scene/gravity/2"}]}})";
+  Diagnostics diag;
+  const auto study = load(diag, text);
+  ASSERT_TRUE(study) << diag.format();
+  const DesignEvaluator evaluator(*study);
+  std::vector<double> f;
+  for (double g : {-9.81, 0.0, -30.0}) {
+    const DesignOutcome o = evaluator.evaluate({g});
+    ASSERT_EQ(o.status, "ok") << o.message;
+    EXPECT_EQ(o.responses.at(0), alone(evaluator, {g})) << g;
+    f.push_back(o.responses.at(0));
+  }
+  // Linearized about the sagged equilibrium, f1 moves with gravity (about the initial state
+  // without it): the three designs differ.
+  EXPECT_NE(f[1], f[0]);
+  EXPECT_NE(f[0], f[2]);
+}
+
 }  // namespace
 }  // namespace beamrail

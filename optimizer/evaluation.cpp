@@ -13,6 +13,7 @@
 #include "optimizer/result_tables.hpp"
 #include "optimizer/tables.hpp"
 #include "optimizer/trajectory.hpp"
+#include "optimizer/vtk_output.hpp"
 
 namespace beamrail {
 namespace {
@@ -130,6 +131,10 @@ class Runner {
     const Model& model = case_model(spec.load_case);
     static_responses(study_, index, model, *e.data, ev_.responses);
     state.ok = true;
+    if (!draw(report, [&](std::string* error) {
+          return options_.vtk->write_static(spec.name, model, *e.data, error);
+        }))
+      return;
     if (!writes_tables()) return;
     const std::string prefix = table_prefix(spec);
     std::string error;
@@ -188,6 +193,10 @@ class Runner {
                     &ev_.tracked_shapes, &chosen);
     add_warnings(warnings);
     keep_modes(state, model, options, r, chosen);
+    if (!draw(report, [&](std::string* error) {
+          return options_.vtk->write_modes(spec.name, model, data, r, error);
+        }))
+      return;
     if (!writes_tables()) return;
     const std::string prefix = table_prefix(spec);
     std::string error;
@@ -255,6 +264,10 @@ class Runner {
           rs.mode <= static_cast<int>(r.modes.size()))
         state.response_mode[k] = rs.mode - 1;
     }
+    if (!draw(report, [&](std::string* error) {
+          return options_.vtk->write_buckling(spec.name, model_, data, r, error);
+        }))
+      return;
     if (!writes_tables()) return;
     const std::string prefix = table_prefix(spec);
     std::string error;
@@ -291,6 +304,7 @@ class Runner {
         peaks.emplace_back(k, PointTracker(model, study_.responses[k]));
         ev_.responses[k] = 0.0;
       }
+    if (options_.vtk && !options_.vtk->begin_series(spec.name, model, &report.message)) return;
     TimeseriesWriter table;
     std::string table_error;
     const bool tables = writes_tables();
@@ -311,6 +325,7 @@ class Runner {
       for (auto& [k, t] : peaks)
         ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
       if (tables) table.write(s, d);  // throws when the table cannot be written: the run fails
+      if (options_.vtk) options_.vtk->frame(s.t, d);  // throws likewise
       if (spec.verify) trajectory.record(s, d);
     };
     const TransientResult result = run_transient(model, options, data, observer);
@@ -318,6 +333,7 @@ class Runner {
         report.energy_initial != 0.0 ? report.energy_max_change / std::abs(report.energy_initial)
                                      : kNaN;
     if (tables) table.commit(&table_error);
+    if (options_.vtk && table_error.empty()) options_.vtk->end_series(&table_error);
     report.ok = result.ok;
     report.timed_out = result.timed_out;
     report.interrupted = result.interrupted;
@@ -373,6 +389,18 @@ class Runner {
   }
 
   bool writes_tables() const { return !options_.output_directory.empty(); }
+
+  // Writes the analysis's VTK files when asked for (write(&error)); false, with the analysis
+  // failed, when they cannot be written.
+  template <class Write>
+  bool draw(AnalysisReport& report, Write&& write) {
+    if (!options_.vtk) return true;
+    std::string error;
+    if (write(&error)) return true;
+    report.ok = false;
+    report.message = error;
+    return false;
+  }
 
   static std::string table_prefix(const AnalysisSpec& spec) { return table_file(spec, ""); }
 

@@ -17,6 +17,8 @@
 
 namespace beamrail {
 
+class VtkOutput;
+
 // A transient rerun at tolerances ten times tighter: the error the run achieved beside its cost.
 struct Verification {
   bool ok = false;
@@ -126,6 +128,8 @@ struct EvaluationOptions {
   const ModeShapes* mode_references = nullptr;
   // Keep the states the analyses reported about (Evaluation::states), for design sensitivities.
   bool keep_states = false;
+  // Where the analyses draw their VTK files (optimizer/vtk_output.hpp); nullptr: none.
+  VtkOutput* vtk = nullptr;
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed

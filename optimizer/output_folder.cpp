@@ -117,6 +117,7 @@ bool OutputFolder::start(const Study& study, std::string* error) const {
 nlohmann::json study_content(const Study& study) {
   nlohmann::json content = study.document;
   if (content.is_object()) content.erase("description");
+  if (content.is_object()) content.erase("outputs");  // what is written besides, not the results
   return content;
 }
 
@@ -136,6 +137,7 @@ std::string resume_refusal(const Study& study, const fs::path& directory,
   if (before.is_discarded() || !before.is_object())
     return "cannot resume: " + record.string() + " is not the record of a study" + what_to_do;
   before.erase("description");
+  before.erase("outputs");
   const nlohmann::json now = study_content(study);
   if (before == now) return "";
   const nlohmann::json patch = nlohmann::json::diff(before, now);

@@ -41,7 +41,7 @@ inline constexpr const char* kLockFile = ".beamrail.lock";
 inline constexpr const char* kStudyRecord = "resolved_study.json";
 
 // What defines a study's results: the study as read, its scene file inlined, without its
-// "description" (the command line, such as -j, is not part of it).
+// "description" and "outputs" (the command line, such as -j, is not part of it).
 nlohmann::json study_content(const Study& study);
 
 // Whether the batch table `table` in `directory` may be continued by this study: "" when it may

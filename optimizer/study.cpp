@@ -184,6 +184,11 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
     resolve_expressions(study, diag);
     if (const Json* design = r.member("study", false))
       study.design = read_design_study(*design, root / "study", study, diag);
+    // What a run writes besides the tables (docs/study_files.md "Outputs").
+    if (const Json* outputs = r.member("outputs", false)) {
+      ObjectReader o(*outputs, root / "outputs", diag);
+      if (o.is_object()) study.vtk = o.boolean("vtk", false).value_or(false);
+    }
   }
 
   if (diag.size() > errors_before || !model) return std::nullopt;

@@ -18,6 +18,8 @@
 #include "optimizer/sweep.hpp"
 #include "optimizer/tables.hpp"
 #include "optimizer/version.hpp"
+#include "optimizer/vtk_design.hpp"
+#include "optimizer/vtk_output.hpp"
 #include "optimizer/work_precision.hpp"
 
 namespace beamrail {
@@ -27,7 +29,7 @@ constexpr const char* kUsage =
     R"(beamrail - design optimizer for rigid bodies joined by elastic beams and rails
 
 Usage:
-  beamrail run STUDY.json [-o OUTDIR] [-j THREADS] [--resume] [--quiet]
+  beamrail run STUDY.json [-o OUTDIR] [-j THREADS] [--resume] [--quiet] [--vtk [--design ROW]]
   beamrail check STUDY.json
   beamrail --help | --version
 
@@ -43,6 +45,11 @@ Options:
   --resume              continue an interrupted sweep or optimization in OUTDIR (refused
                         when OUTDIR's tables were written by another version of the study)
   --quiet               no progress output
+  --vtk                 also write VTK files for ParaView into OUTDIR/vtk (as "outputs":
+                        {"vtk": true} does): a .pvd per analysis; for a design study, of the
+                        best design (optimize) or of the design chosen with --design
+  --design ROW          the design the VTK files draw: a sweep's index (samples.csv), an
+                        optimization's EVALUATION of start 1 or START:EVALUATION (history.csv)
 
 Exit status: 0 success; 1 the run failed, or its results could not be written, or OUTDIR is
 in use by another run (the reason is printed, partial tables are kept); 2 bad input (unreadable
@@ -56,12 +63,15 @@ struct RunArguments {
   int threads = 0;
   bool resume = false;
   bool quiet = false;
+  bool vtk = false;                   // --vtk
+  std::optional<std::string> design;  // --design ROW
 };
 
 // The message and the usage lines only: the full help would bury the message.
 int usage_error(const std::string& message) {
   std::cerr << "beamrail: " << message << "\n"
-            << "usage: beamrail run STUDY.json [-o OUTDIR] [-j THREADS] [--resume] [--quiet]\n"
+            << "usage: beamrail run STUDY.json [-o OUTDIR] [-j THREADS] [--resume] [--quiet] "
+               "[--vtk [--design ROW]]\n"
             << "       beamrail check STUDY.json\n"
             << "       beamrail --help | --version\n";
   return 2;
@@ -99,6 +109,12 @@ std::optional<int> parse_run_arguments(const std::vector<std::string>& args, boo
       out.resume = true;
     } else if (run && a == "--quiet") {
       out.quiet = true;
+    } else if (run && a == "--vtk") {
+      out.vtk = true;
+    } else if (run && a == "--design") {
+      const auto v = value("ROW");
+      if (!v || v->empty()) return usage_error(a + " needs a design (a row of the batch's table)");
+      out.design = *v;
     } else if (!a.empty() && a[0] == '-') {
       return usage_error("unknown option " + a);
     } else if (out.study.empty()) {
@@ -149,8 +165,14 @@ std::string resumable_table(const Study& study) {
   return "";
 }
 
-int run_single(const Study& study, const std::filesystem::path& out) {
-  const Evaluation ev = evaluate(study, study.model, {out});
+int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
+  EvaluationOptions options{out};
+  std::optional<VtkOutput> vtk_output;
+  if (vtk) options.vtk = &vtk_output.emplace(out / "vtk");
+  Evaluation ev = evaluate(study, study.model, options);
+  std::string vtk_error;
+  if (vtk_output && !vtk_output->finish(nullptr, &vtk_error) && ev.status == "ok")
+    ev.status = "failed", ev.message = vtk_error;
   const nlohmann::json summary = evaluation_summary(study, study.model, ev);
   std::string error;
   if (!write_file_atomically(out / "summary.json", summary.dump(2) + "\n", &error)) {
@@ -185,6 +207,15 @@ int run(const RunArguments& args) {
     return 2;
   }
   for (const std::string& w : study->input_warnings) std::cerr << "warning: " << w << "\n";
+  // Which design the VTK files draw; a bad --design is refused before the folder is touched.
+  const bool vtk = args.vtk || study->vtk;
+  DesignChoice drawn;
+  if (const std::string refusal =
+          choose_design(*study, vtk, args.design ? &*args.design : nullptr, &drawn);
+      !refusal.empty()) {
+    std::cerr << "beamrail: " << refusal << "\n";
+    return 2;
+  }
   const std::filesystem::path out = args.output.empty()
                                         ? std::filesystem::path("results") / study->name
                                         : std::filesystem::path(args.output);
@@ -211,18 +242,25 @@ int run(const RunArguments& args) {
   const StopOnSignals signals;
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {
+    int status = 0;
     switch (study->design->type) {
       case DesignStudy::Type::kSweep:
-        return run_sweep(*study, settings);
+        status = run_sweep(*study, settings);
+        break;
       case DesignStudy::Type::kOptimize:
-        return run_optimize(*study, settings);
+        status = run_optimize(*study, settings);
+        break;
       case DesignStudy::Type::kWorkPrecision:
-        return run_work_precision(*study, settings);
+        status = run_work_precision(*study, settings);
+        break;
       case DesignStudy::Type::kSensitivity:
-        return run_sensitivity(*study, settings);
+        status = run_sensitivity(*study, settings);
+        break;
     }
+    // The VTK files of the design chosen, once the batch has succeeded.
+    return status == 0 ? draw_design(*study, drawn, out, args.quiet) : status;
   }
-  return run_single(*study, out);
+  return run_single(*study, out, vtk);
 }
 
 int dispatch(const std::vector<std::string>& args) {

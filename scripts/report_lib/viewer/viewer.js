@@ -86,7 +86,7 @@ class Viewer {
       boxGeometry,
       new THREE.MeshStandardMaterial({
         color: 0x8fa8c8, flatShading: true, metalness: 0.1, roughness: 0.7,
-        side: THREE.DoubleSide, transparent: true, opacity: 0.85,
+        side: THREE.DoubleSide, transparent: true, opacity: 0.5,
       }));
     this.group.add(this.boxMesh);
     const levers = decode(v.levers, Int32Array);

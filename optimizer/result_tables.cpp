@@ -112,14 +112,15 @@ bool write_modal_tables(const std::filesystem::path& directory, const std::strin
 bool write_buckling_tables(const std::filesystem::path& directory, const std::string& prefix,
                            const Model& model, const BucklingResult& result, std::string* error) {
   CsvWriter factors, shapes;
-  if (!factors.open(directory / (prefix + "buckling.csv"), {"mode", "factor"}, error, true) ||
+  if (!factors.open(directory / (prefix + "buckling.csv"), {"mode", "factor", "nonlinearity"},
+                    error, true) ||
       !shapes.open(directory / (prefix + "buckling_shapes.csv"),
                    {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
     return false;
   for (size_t m = 0; m < result.modes.size(); ++m) {
     const BucklingMode& mode = result.modes[m];
     const std::string number = std::to_string(m + 1);
-    factors.row({number, format_number(mode.factor)});
+    factors.row({number, format_number(mode.factor), format_number(mode.nonlinearity)});
     for (int k = 0; k < model.n_free(); ++k) {
       std::vector<std::string> row{number, model.bodies[model.free_bodies[k]].name};
       for (int c = 0; c < 6; ++c) row.push_back(format_number(mode.shape(6 * k + c)));

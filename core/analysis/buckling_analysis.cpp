@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/analysis/buckling_path.hpp"
 #include "core/analysis/deadline.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
@@ -282,7 +283,27 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
     result.positive_factors = static_cast<int>(order.size());
     for (Eigen::Index i : order) {
       if (static_cast<int>(result.modes.size()) >= wanted) break;
-      result.modes.push_back({1.0 / mu(i), normalized_shape(vectors.col(i), length)});
+      const double factor = 1.0 / mu(i);
+      // How far the stiffness along the shape is from zero on the prebuckling path at the factor
+      // (core/analysis/buckling_path.hpp): what the linearization in the load leaves out.
+      const Eigen::VectorXd phi = vectors.col(i);
+      const double nonlinearity =
+          std::abs(
+              phi.dot(path_stiffness_product(reference, scaled, t, data, matrices.u1, factor, phi)
+                          .col(0))) /
+          phi.dot(k0 * phi);
+      deadline.check();
+      result.modes.push_back({factor, normalized_shape(phi, length), nonlinearity});
+      if (nonlinearity > kBucklingNonlinearityLimit)
+        result.warnings.push_back(
+            text("buckling mode %.0f: ", static_cast<double>(result.modes.size())) +
+            text("the tangent stiffness changes with the prebuckling deformation beyond first "
+                 "order: at the factor %.6g ",
+                 factor) +
+            text("the shape keeps %.2g of its stiffness on the prebuckling path, so the factor "
+                 "may be off by about as much (segments short beside their section make this; "
+                 "a static analysis with the loads near the factor tells)",
+                 nonlinearity));
     }
     result.ok = true;
     if (result.positive_factors < wanted)

@@ -47,7 +47,15 @@ struct BucklingMode {
   // The buckling shape (dim n_dofs): the largest of |translation| and |rotation| x the
   // characteristic length is 1, and the largest entry positive.
   Eigen::VectorXd shape;
+  // |phi^T K(u0 + lambda u1) phi| / phi^T K0 phi: how much stiffness the shape keeps on the
+  // linear prebuckling path at the factor, which the linearization K0 + lambda K1 takes as 0
+  // (core/analysis/buckling_path.hpp); about the factor's relative uncertainty from what the
+  // linearization leaves out.
+  double nonlinearity = 0.0;
 };
+
+// Above this nonlinearity a mode's factor comes with a warning.
+inline constexpr double kBucklingNonlinearityLimit = 1e-3;
 
 struct BucklingResult {
   bool ok = false;

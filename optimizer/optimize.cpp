@@ -153,6 +153,8 @@ class Optimization {
   const RunSettings& settings_;
   Progress progress_;
   BatchTable history_;
+  // derivatives.csv (exact gradients): each design's derivatives, read back by --resume
+  BatchTable derivatives_;
   std::map<Design, DesignOutcome> cache_;  // every design evaluated, this run or before
   // The exact derivatives of the designs evaluated with them (null: none, see gradient_fallbacks_)
   std::map<Design, std::shared_ptr<const Eigen::MatrixXd>> jacobians_;
@@ -382,6 +384,12 @@ void Optimization::record_derivatives(const Design& x, const DesignOutcome& o,
   // Under mutex_.
   if (s.ok) {
     ++exact_gradients_;
+    CsvRow row;
+    for (double v : x) row.push_back(format_number(v));
+    for (Eigen::Index k = 0; k < s.jacobian.rows(); ++k)
+      for (Eigen::Index j = 0; j < s.jacobian.cols(); ++j)
+        row.push_back(format_number(s.jacobian(k, j)));
+    if (!derivatives_.append(row)) write_failed_ = true;
     jacobians_[x] = std::make_shared<const Eigen::MatrixXd>(std::move(s.jacobian));
     for (std::string& w : s.warnings)
       if (sensitivity_warnings_.size() < 20) sensitivity_warnings_.insert(std::move(w));
@@ -911,8 +919,37 @@ int Optimization::run() {
     cache_.try_emplace(x, o);
   }
 
+  // The derivatives of earlier designs (exact gradients), by design.
+  if (exact_gradients()) {
+    CsvRow columns;
+    for (const DesignVariable& v : variables_) columns.push_back(v.name);
+    for (const ResponseSpec& r : study_.responses)
+      for (const DesignVariable& v : variables_)
+        columns.push_back("d " + r.name + " / d " + v.name);
+    std::vector<CsvRow> rows;
+    switch (derivatives_.open(settings_.output / "derivatives.csv", columns, settings_.resume,
+                              &rows, &error)) {
+      case BatchTable::Opened::kOk:
+        break;
+      case BatchTable::Opened::kOtherColumns:
+        std::cerr << "beamrail: " << error << "\n";
+        return 2;
+      case BatchTable::Opened::kWriteError:
+        std::cerr << "beamrail: " << error << "\n";
+        return 1;
+    }
+    for (const CsvRow& r : rows) {
+      Design x;
+      for (size_t i = 0; i < nv; ++i) x.push_back(std::strtod(r[i].c_str(), nullptr));
+      auto jacobian = std::make_shared<Eigen::MatrixXd>(nr, nv);
+      for (size_t k = 0; k < nr; ++k)
+        for (size_t j = 0; j < nv; ++j)
+          (*jacobian)(k, j) = std::strtod(r[nv + k * nv + j].c_str(), nullptr);
+      jacobians_.try_emplace(x, std::move(jacobian));
+    }
+  }
+
   const std::vector<Design> points = start_points();
-  // Designs evaluated at once: the starts, or the central-difference points of one gradient.
   // Designs evaluated at once: the starts, the central-difference points of one gradient, or
   // the variables whose derivatives one design's sensitivities compute in parallel.
   const long n_variables = static_cast<long>(variables_.size());
@@ -947,7 +984,12 @@ int Optimization::run() {
   for (int s = 0; s < n_starts; ++s) run_start(starts[s], points[s]);
 
   progress_.finish();
-  const bool written = history_.finalize({0, 1}, &error);
+  bool written = history_.finalize({0, 1}, &error);
+  if (written && exact_gradients()) {
+    std::vector<int> keys;
+    for (size_t i = 0; i < nv; ++i) keys.push_back(static_cast<int>(i));
+    written = derivatives_.finalize(keys, &error);
+  }
   // The best feasible design; ties go to the earliest (start, evaluation).
   const Record* best = nullptr;
   std::sort(records_.begin(), records_.end(), [](const Record& a, const Record& b) {

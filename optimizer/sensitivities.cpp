@@ -184,7 +184,7 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
           // f = sqrt(lambda) / (2 pi): df = dlambda / (8 pi^2 f).
           const double f = std::sqrt(a.eigenvalues[m]) / (2.0 * std::numbers::pi);
           column(k) = d.values[m] / (8.0 * std::numbers::pi * std::numbers::pi * f);
-          if (d.crossing[m] > 0)
+          if (d.crossing[m] == 1 || d.crossing[m] == 2)
             out.warnings.push_back(
                 "frequency response \"" + design_.responses[k].name + "\" (mode " +
                 std::to_string(m + 1) + ") is " +

@@ -117,16 +117,23 @@ EigenvalueDerivatives cluster_derivatives(
       const double sign = b(0, 0) < 0.0 ? -1.0 : 1.0;
       const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(
           0.5 * sign * (a + a.transpose()), 0.5 * sign * (b + b.transpose()));
+      // The cluster splits as p grows when its derivatives differ (a square section's bending
+      // pair as its width grows); when they are equal (a round section's pair as its diameter
+      // grows) it stays one repeated eigenvalue, whose derivative is that.
+      const double spread = eig.eigenvalues().maxCoeff() - eig.eigenvalues().minCoeff();
+      const double size_of = eig.eigenvalues().cwiseAbs().maxCoeff();
       for (int i = 0; i < size; ++i) {
         out.values[first + i] = eig.eigenvalues()(i);
-        out.crossing[first + i] = 2;
+        out.crossing[first + i] = spread > 1e-6 * size_of ? 2 : 3;
       }
     }
     first = last + 1;
   }
+  // Near another eigenvalue that is not its cluster's.
   for (int i = 0; i < n; ++i)
-    if (out.crossing[i] == 0 && ((i > 0 && close(i - 1, i, kNearCrossing)) ||
-                                 (i + 1 < n && close(i, i + 1, kNearCrossing))))
+    if (out.crossing[i] == 0 &&
+        ((i > 0 && close(i - 1, i, kNearCrossing) && !close(i - 1, i, kClusterGap)) ||
+         (i + 1 < n && close(i, i + 1, kNearCrossing) && !close(i, i + 1, kClusterGap))))
       out.crossing[i] = 1;
   return out;
 }

@@ -91,7 +91,8 @@ double directional_derivative(const Model& base_model, const Data& base, const D
 struct EigenvalueDerivatives {
   std::vector<double> values;  // dlambda/dp per eigenvalue given
   // Per eigenvalue: 0 alone, 1 near a crossing (within kNearCrossing of another), 2 in a cluster
-  // (within kClusterGap: the directional derivative as p grows).
+  // (within kClusterGap) that splits as p grows (the directional derivative as p grows), 3 in a
+  // cluster that stays repeated (its members' derivatives are equal).
   std::vector<int> crossing;
 };
 

@@ -158,6 +158,19 @@ std::string without_column(const std::string& text, const std::string& name) {
 
 uint64_t bits(double x) { return std::bit_cast<uint64_t>(x); }
 
+// Fields first .. first + count - 1 of a CSV line without quoted fields, joined by commas.
+std::string fields_of(const std::string& line, size_t first, size_t count) {
+  std::vector<std::string> f;
+  size_t start = 0;
+  for (size_t i = 0; i <= line.size(); ++i)
+    if (i == line.size() || line[i] == ',')
+      f.push_back(line.substr(start, i - start)), start = i + 1;
+  std::string out;
+  for (size_t i = first; i < first + count && i < f.size(); ++i)
+    out += (out.empty() ? "" : ",") + f[i];
+  return out;
+}
+
 // --- Fixture ------------------------------------------------------------------------------------
 
 class DesignStudyRuns : public ::testing::Test {
@@ -464,12 +477,14 @@ TEST_F(DesignStudyRuns, OneAndTwoThreadsGiveIdenticalTables) {
   EXPECT_EQ(lines_of(s1).size(), 901u);
   EXPECT_TRUE(SameText(without_column(s1, "wall_s"), without_column(s2, "wall_s")));
 
-  // Optimizations: min_mass_rod with one gradient-based start (its finite-difference points
-  // evaluate in parallel) and with three (the starts run in parallel), and the portal frame (two
-  // COBYLA starts).
+  // Optimizations: min_mass_rod with one gradient-based start on central differences (its
+  // difference points evaluate in parallel) and with three on exact derivatives (the starts run in
+  // parallel; derivatives.csv too), and the portal frame (two COBYLA starts).
   Json rod = load_json(kStudies / "min_mass_rod.json");
   rod["study"]["algorithm"] = "LD_SLSQP";
+  rod["study"]["gradient"] = "fd";
   const fs::path rod1 = write_study("rod1.json", rod);
+  rod["study"]["gradient"] = "exact";
   rod["study"]["starts"] = 3;
   const fs::path rod3 = write_study("rod3.json", rod);
   for (const fs::path& file : {rod1, rod3, kStudies / "portal_frame_design.json"}) {
@@ -487,6 +502,9 @@ TEST_F(DesignStudyRuns, OneAndTwoThreadsGiveIdenticalTables) {
     EXPECT_TRUE(SameText(without_column(h1, "wall_s"), without_column(h2, "wall_s")));
     EXPECT_TRUE(SameText(read_text(a / "best.json"), read_text(b / "best.json")));
     EXPECT_TRUE(SameText(read_text(a / "best_scene.json"), read_text(b / "best_scene.json")));
+    EXPECT_EQ(fs::exists(a / "derivatives.csv"), file == rod3);
+    if (file == rod3)
+      EXPECT_TRUE(SameText(read_text(a / "derivatives.csv"), read_text(b / "derivatives.csv")));
   }
 }
 
@@ -607,6 +625,19 @@ TEST_F(DesignStudyRuns, OptimizationResumesFromHalfItsHistory) {
     for (size_t i = 0; i <= kept; ++i) text += lines[i] + "\n";
     text += lines[kept + 1].substr(0, lines[kept + 1].size() / 2);
     save_text(dir_ / "out" / "history.csv", text);
+    // Exact gradients: the derivatives of the kept rows' designs, as the interrupted run left
+    // them (in the order the designs finished, which the reference's sorted table is not).
+    if (fs::exists(dir_ / "ref" / "derivatives.csv")) {
+      const std::vector<std::string> d = lines_of(read_text(dir_ / "ref" / "derivatives.csv"));
+      std::string kept_derivatives = d[0] + "\n";
+      for (size_t i = 1; i < d.size(); ++i)
+        for (size_t r = 1; r <= kept; ++r)
+          if (d[i].rfind(fields_of(lines[r], 2, 1) + ",", 0) == 0) {
+            kept_derivatives += d[i] + "\n";
+            break;
+          }
+      save_text(dir_ / "out" / "derivatives.csv", kept_derivatives);
+    }
     ASSERT_NO_FATAL_FAILURE(run_ok(file, "out", {"--resume", "-j", "2"}));
     const Json summary = load_json(dir_ / "out" / "summary.json");
     const long simulated = summary["designs_simulated"],
@@ -621,6 +652,9 @@ TEST_F(DesignStudyRuns, OptimizationResumesFromHalfItsHistory) {
         SameText(read_text(dir_ / "ref" / "best.json"), read_text(dir_ / "out" / "best.json")));
     EXPECT_TRUE(SameText(read_text(dir_ / "ref" / "best_scene.json"),
                          read_text(dir_ / "out" / "best_scene.json")));
+    if (fs::exists(dir_ / "ref" / "derivatives.csv"))
+      EXPECT_TRUE(SameText(read_text(dir_ / "ref" / "derivatives.csv"),
+                           read_text(dir_ / "out" / "derivatives.csv")));
     // Each row's design is simulated once at most; the kept rows are not simulated again.
     EXPECT_GT(simulated, 0);
     EXPECT_LT(simulated, ref_simulated);

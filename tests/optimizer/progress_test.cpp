@@ -139,6 +139,7 @@ TEST(ProgressLine, AnOptimizationOnATerminalCountsDesignsWithinItsBudgetAndShows
   s["scene"]["beams"][0]["segments"] = 400;  // with 40 modes, about 30 ms a design
   s["analyses"][0]["modes"] = 40;
   s["study"]["algorithm"] = "LD_SLSQP";
+  s["study"]["gradient"] = "fd";  // central differences: 3 designs per call
   s["study"]["max_evaluations"] = 30;
   s["study"]["starts"] = 2;
   std::ofstream(dir / "rod.json") << s.dump(2);

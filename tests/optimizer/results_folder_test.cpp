@@ -556,6 +556,7 @@ TEST_F(ResultsFolder, ThreadsAreCappedByTheWorkAndAbsurdCountsRefused) {
   sweep["study"]["variables"][1]["values"] = Json{0.002};
   Json rod = load_json(kStudies / "min_mass_rod.json");
   rod["study"]["algorithm"] = "LD_SLSQP";  // gradients: 3 designs at once for 1 variable
+  rod["study"]["gradient"] = "fd";         // (by central differences)
   rod["study"]["max_evaluations"] = 5;
 #if defined(__SANITIZE_ADDRESS__)
   // AddressSanitizer reserves terabytes of address space: no limit then (the thread count in

@@ -169,6 +169,7 @@ class Runner {
       options.time = e.time;
     }
     options.max_seconds = budget_left(options.max_seconds);
+    options.structure_cache = structure_cache();  // the designs share the ordering of K + mu M
     for (const ResponseSpec& response : study_.responses)
       options.keep_mass = options.keep_mass || (response.analysis == index && response.track);
     const ModalResult r = solve_modal(model, options, data);

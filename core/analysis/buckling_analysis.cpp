@@ -248,9 +248,10 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
 
     // -K1 x = mu K0 x, mu = 1 / lambda: the largest positive mu are the lowest positive factors.
     const int wanted = std::max(1, options.modes);
-    const bool dense = options.solver == EigenSolverKind::kDense ||
-                       (options.solver == EigenSolverKind::kAuto && n <= options.dense_limit) ||
-                       n < wanted + 24;
+    const bool dense =
+        options.solver == EigenSolverKind::kDense ||
+        (options.solver == EigenSolverKind::kAuto && buckling_dense_is_faster(n, wanted)) ||
+        n < wanted + 24;
     Eigen::VectorXd mu;
     Eigen::MatrixXd vectors;
     if (dense) {

@@ -12,11 +12,13 @@
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 
 #include "core/analysis/deadline.hpp"
 #include "core/analysis/element_deformation.hpp"
+#include "core/analysis/sparse_structure.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
 
@@ -38,34 +40,78 @@ double choose_shift(const Model& model, const SparseMatrix& k, const SparseMatri
   return scale > 0.0 ? 1e4 * std::numeric_limits<double>::epsilon() * scale : 1.0;
 }
 
-// y = (K - sigma M)^-1 x for Spectra's shift-invert mode, by a sparse LDL^T (fill-reducing
-// ordering; K - sigma M is definite, or mildly indefinite about an unstable configuration).
+// Eigen's SimplicialLDLT factoring a matrix already permuted, P A P^T (upper triangle), as it
+// factors A internally after choosing P: the same symbolic and numeric steps in the same order, so
+// the same factors to the last bit, without the copies compute() makes of a preordered matrix.
+class PreorderedLdlt
+    : public Eigen::SimplicialLDLT<SparseMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>> {
+ public:
+  void compute_preordered(const SparseMatrix& upper) {
+    m_P.resize(0);
+    m_Pinv.resize(0);
+    analyzePattern_preordered(upper, true);
+    factorize_preordered<true>(upper);
+  }
+};
+
+// y = (K - sigma M)^-1 x for Spectra's shift-invert mode, by a sparse LDL^T (K - sigma M is
+// definite, or mildly indefinite about an unstable configuration) of P (K - sigma M) P^T with the
+// fill-reducing ordering P: the topology's, shared between the designs of a sweep when a cache
+// is given (ModalOptions::structure_cache), else its own. Either way the steps of
+// SimplicialLDLT<SparseMatrix> on K - sigma M, which chooses the same P: the same factors and
+// solutions to the last bit, with or without the cache.
 class ShiftSolve {
  public:
   using Scalar = double;
-  ShiftSolve(const SparseMatrix& k, const SparseMatrix& m, const Deadline& budget)
-      : k_(k), m_(m), budget_(budget) {}
+  ShiftSolve(const SparseMatrix& k, const SparseMatrix& m, const SymmetricOrdering* ordering,
+             const Deadline& budget)
+      : k_(k), m_(m), ordering_(ordering), budget_(budget) {}
   Eigen::Index rows() const { return k_.rows(); }
   Eigen::Index cols() const { return k_.cols(); }
   void set_shift(double sigma) {
     budget_.check();
-    const SparseMatrix a = k_ - sigma * m_;
-    ldlt_.compute(a);
+    // K - sigma M: K's pattern holds M's (a body's own block), so the shift changes K's entries
+    // in place of a sparse sum, each to k - sigma m as the sum computes it; no copy when sigma = 0.
+    const SparseMatrix* a = &k_;
+    SparseMatrix shifted;
+    if (sigma != 0.0) {
+      shifted = k_;
+      for (Eigen::Index c = 0; c < m_.outerSize(); ++c)
+        for (SparseMatrix::InnerIterator it(m_, c); it; ++it)
+          shifted.coeffRef(it.row(), c) -= sigma * it.value();
+      a = &shifted;
+    }
+    if (!ordering_) {
+      own_ordering_ = symmetric_ordering(*a);
+      ordering_ = &own_ordering_;
+    }
+    inverse_ = ordering_->inverse();
+    SparseMatrix upper(a->rows(), a->cols());
+    upper.selfadjointView<Eigen::Upper>() =
+        a->selfadjointView<Eigen::Lower>().twistedBy(*ordering_);
+    budget_.check();
+    ldlt_.compute_preordered(upper);
     if (ldlt_.info() != Eigen::Success)
       throw std::runtime_error("the shifted stiffness K + mu M could not be factored");
     budget_.check();
   }
   void perform_op(const double* x, double* y) const {
     budget_.check();
-    Eigen::Map<Eigen::VectorXd>(y, rows()) =
-        ldlt_.solve(Eigen::Map<const Eigen::VectorXd>(x, rows()));
+    work_.noalias() = *ordering_ * Eigen::Map<const Eigen::VectorXd>(x, rows());
+    ldlt_.matrixL().solveInPlace(work_);
+    work_ = ldlt_.vectorD().asDiagonal().inverse() * work_;
+    ldlt_.matrixU().solveInPlace(work_);
+    Eigen::Map<Eigen::VectorXd>(y, rows()).noalias() = inverse_ * work_;
   }
 
  private:
   const SparseMatrix& k_;
   const SparseMatrix& m_;
+  const SymmetricOrdering* ordering_;
   const Deadline& budget_;
-  Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+  SymmetricOrdering own_ordering_, inverse_;
+  PreorderedLdlt ldlt_;
+  mutable Eigen::VectorXd work_;  // the permuted right-hand side, solved in place
 };
 
 struct Eigenpairs {
@@ -80,11 +126,11 @@ bool solve_dense(const SparseMatrix& k, const SparseMatrix& m, double shift, Eig
 
 // The `count` eigenpairs nearest the shift -mu by Lanczos; false when it did not converge.
 bool solve_lanczos(const SparseMatrix& k, const SparseMatrix& m, double shift, Eigen::Index count,
-                   const Deadline& budget, Eigenpairs& out) {
+                   const SymmetricOrdering* ordering, const Deadline& budget, Eigenpairs& out) {
   const Eigen::Index n = k.rows();
   const Eigen::Index nev = std::min<Eigen::Index>(n - 1, count);
   const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
-  ShiftSolve op(k, m, budget);
+  ShiftSolve op(k, m, ordering, budget);
   Spectra::SparseSymMatProd<double> bop(m);
   Spectra::SymGEigsShiftSolver<ShiftSolve, Spectra::SparseSymMatProd<double>,
                                Spectra::GEigsMode::ShiftInvert>
@@ -400,17 +446,24 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     budget.check();
     const int wanted = std::max(1, options.modes);
     const Eigen::Index n = model.n_dofs;
-    const bool dense = options.solver == EigenSolverKind::kDense ||
-                       (options.solver == EigenSolverKind::kAuto && n <= options.dense_limit) ||
-                       n < 2 * wanted + 24;
     result.shift = choose_shift(model, sym, m);
-    const ElementDeformation deformation(model, data);
-
     // Torques of fixed direction make the loaded state non-conservative and K non-symmetric
     // at equilibrium: its own eigenproblem then, never its symmetric part (a cantilever bent by
     // a tip torque: 3.485 Hz from the symmetric part, 3.645 Hz from the non-symmetric problem
     // and from a transient). Rounding leaves ~1e-15.
     const bool nonsymmetric = result.asymmetry > kModalAsymmetryLimit;
+    // Shift-invert asks for the wanted modes plus room for rigid ones: none when every body is
+    // held by beams (mu = 0: no mode deforms no element), else 12 more at first. Below twice
+    // that many degrees of freedom (Lanczos's subspace, 2 pairs + 1, would not fit) the dense
+    // solver, whatever was asked.
+    const Eigen::Index first_extra = result.shift == 0.0 && !nonsymmetric ? 0 : 12;
+    const Eigen::Index lanczos_pairs = wanted + first_extra;
+    const bool dense =
+        options.solver == EigenSolverKind::kDense ||
+        (options.solver == EigenSolverKind::kAuto && modal_dense_is_faster(n, lanczos_pairs)) ||
+        n < 2 * lanczos_pairs || n < 3;
+    const ElementDeformation deformation(model, data);
+
     SparseMatrix k;
     if (nonsymmetric) k = -stiffness_matrix(model, data);
     int complex_pairs = 0;
@@ -426,14 +479,20 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
       found = classify(pairs, m, deformation, result.shift, wanted, result);
       result.solver = "dense";
     } else {
+      // The topology's fill-reducing ordering of K + mu M (K's pattern), made by the first
+      // design that asks and shared by the others.
+      std::shared_ptr<const SymmetricOrdering> ordering;
+      if (!nonsymmetric && options.structure_cache)
+        ordering = options.structure_cache->ordering(model, sym);
       // Rigid modes take places among the pairs nearest the shift: ask for more until enough
       // non-rigid ones are among them or every pair is.
-      for (Eigen::Index extra = 12;; extra *= 4) {
+      for (Eigen::Index extra = first_extra;; extra = std::max<Eigen::Index>(12, 4 * extra)) {
         const Eigen::Index count = std::min<Eigen::Index>(n - 1, wanted + extra);
         Eigenpairs pairs;
-        if (nonsymmetric ? !solve_nonsymmetric(k, m, result.shift, count, false, budget, pairs,
-                                               &complex_pairs, &growth)
-                         : !solve_lanczos(sym, m, result.shift, count, budget, pairs))
+        if (nonsymmetric
+                ? !solve_nonsymmetric(k, m, result.shift, count, false, budget, pairs,
+                                      &complex_pairs, &growth)
+                : !solve_lanczos(sym, m, result.shift, count, ordering.get(), budget, pairs))
           throw std::runtime_error(nonsymmetric
                                        ? "the shift-invert eigensolver (Arnoldi) did not converge"
                                        : "the shift-invert eigensolver did not converge");

@@ -1,5 +1,6 @@
 #include "core/analysis/sparse_structure.hpp"
 
+#include <Eigen/OrderingMethods>
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -64,6 +65,16 @@ JacobianPattern block_pattern(const Model& model, int size, Structural&& structu
 
 }  // namespace
 
+SymmetricOrdering symmetric_ordering(const Eigen::SparseMatrix<double>& a) {
+  // What SimplicialCholeskyBase::ordering does for UpLo = Lower and AMDOrdering: AMD on the full
+  // symmetric matrix the lower triangle stands for gives P^-1.
+  Eigen::SparseMatrix<double> full;
+  full = a.selfadjointView<Eigen::Lower>();
+  SymmetricOrdering inverse;
+  Eigen::AMDOrdering<int>()(full, inverse);
+  return inverse.inverse();
+}
+
 JacobianPattern make_jacobian_pattern(const Model& model) {
   return block_pattern(model, kS, structural);
 }
@@ -92,27 +103,57 @@ SparseStructure::~SparseStructure() {
   }
 }
 
+SparseStructureCache::Entry* SparseStructureCache::find(const Model& model) {
+  for (size_t k = entries_.size(); k-- > 0;)
+    if (same_topology(entries_[k].n_states, entries_[k].blocks, model)) {
+      std::rotate(entries_.begin() + static_cast<long>(k),
+                  entries_.begin() + static_cast<long>(k) + 1, entries_.end());
+      return &entries_.back();
+    }
+  return nullptr;
+}
+
+SparseStructureCache::Entry& SparseStructureCache::insert(const Model& model) {
+  if (entries_.size() == kCapacity) entries_.erase(entries_.begin());
+  entries_.push_back({model.n_states, model.pattern.blocks, nullptr, nullptr});
+  return entries_.back();
+}
+
 std::shared_ptr<const SparseStructure> SparseStructureCache::get(const Model& model) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (size_t k = entries_.size(); k-- > 0;)
-      if (same_topology(entries_[k].n_states, entries_[k].blocks, model)) {
-        std::rotate(entries_.begin() + static_cast<long>(k),
-                    entries_.begin() + static_cast<long>(k) + 1, entries_.end());
-        ++reuses_;
-        return entries_.back().structure;
-      }
+    if (const Entry* e = find(model); e && e->structure) {
+      ++reuses_;
+      return e->structure;
+    }
   }
   // Analysed outside the lock, so other topologies are served meanwhile; two threads meeting a
   // new topology at once both analyse it and the first one stored is kept.
   auto structure = std::make_shared<const SparseStructure>(model);
   std::lock_guard<std::mutex> lock(mutex_);
   ++analyses_;
-  for (const Entry& e : entries_)
-    if (same_topology(e.n_states, e.blocks, model)) return e.structure;
-  if (entries_.size() == kCapacity) entries_.erase(entries_.begin());
-  entries_.push_back({model.n_states, model.pattern.blocks, structure});
-  return structure;
+  Entry* e = find(model);
+  if (!e) e = &insert(model);
+  if (!e->structure) e->structure = std::move(structure);
+  return e->structure;
+}
+
+std::shared_ptr<const SymmetricOrdering> SparseStructureCache::ordering(
+    const Model& model, const Eigen::SparseMatrix<double>& a) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (const Entry* e = find(model); e && e->ordering) {
+      ++ordering_reuses_;
+      return e->ordering;
+    }
+  }
+  auto made = std::make_shared<const SymmetricOrdering>(symmetric_ordering(a));
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++orderings_;
+  Entry* e = find(model);
+  if (!e) e = &insert(model);
+  if (!e->ordering) e->ordering = std::move(made);
+  return e->ordering;
 }
 
 long SparseStructureCache::analyses() const {
@@ -123,6 +164,16 @@ long SparseStructureCache::analyses() const {
 long SparseStructureCache::reuses() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return reuses_;
+}
+
+long SparseStructureCache::orderings() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return orderings_;
+}
+
+long SparseStructureCache::ordering_reuses() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return ordering_reuses_;
 }
 
 }  // namespace beamrail

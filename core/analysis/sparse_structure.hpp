@@ -1,11 +1,14 @@
 // The sparse structure of a topology: which entries of the state Jacobian can be non-zero (a CSC
-// pattern) and KLU's symbolic analysis of it (block triangular form and fill-reducing ordering).
-// Both depend only on which free bodies the elements couple, so every design of one topology
-// shares them: a SparseStructureCache hands the same immutable structure to every run that asks.
+// pattern) and KLU's symbolic analysis of it (block triangular form and fill-reducing ordering),
+// and the fill-reducing ordering of the modal analysis's symmetric matrices. They depend only on
+// which free bodies the elements couple, so every design of one topology shares them: a
+// SparseStructureCache hands the same immutable structure and ordering to every run that asks.
 #pragma once
 
 #include <klu.h>
 
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -33,6 +36,15 @@ JacobianPattern make_jacobian_pattern(const Model& model);
 // Per free body, 7 position states (c, q) and 6 velocity states (v, w).
 constexpr int kPositionStates = 7;
 constexpr int kVelocityStates = 6;
+
+// A fill-reducing ordering of a symmetric matrix, as the permutation P: a sparse Cholesky or LDL^T
+// factors P A P^T.
+using SymmetricOrdering = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
+
+// The ordering Eigen's SimplicialLDLT and SimplicialLLT choose for a matrix whose lower triangle
+// has a's pattern: AMD on the pattern of A + A^T. It reads the pattern only (explicit zeros count,
+// values do not), so every matrix of one pattern has it.
+SymmetricOrdering symmetric_ordering(const Eigen::SparseMatrix<double>& a);
 
 // The pattern, the pattern of the velocity-level system the solver factors (the Schur complement
 // of the position states, 6 x 6 per block: the position rows of a Newton matrix I - gamma J only
@@ -62,25 +74,38 @@ class SparseStructure {
   double analysis_seconds_ = 0.0;
 };
 
-// Structures by topology (the free-body count and the coupled body pairs), shared by every model
-// of that topology. Thread-safe. Keeps the most recently used few.
+// Structures and orderings by topology (the free-body count and the coupled body pairs), shared
+// by every model of that topology. Thread-safe. Keeps the most recently used few topologies.
 class SparseStructureCache {
  public:
   std::shared_ptr<const SparseStructure> get(const Model& model);
 
-  long analyses() const;  // structures made
-  long reuses() const;    // requests answered from the cache
+  // The symmetric_ordering of a matrix on the model's velocity-level pattern (6 x 6 entries per
+  // coupled body pair, dim n_dofs: the modal analysis's stiffness K and K + mu M), made from `a`
+  // at the topology's first request, shared afterwards. Only the ordering is made (no
+  // SparseStructure: a modal analysis needs neither the Jacobian's pattern nor KLU's analysis).
+  std::shared_ptr<const SymmetricOrdering> ordering(const Model& model,
+                                                    const Eigen::SparseMatrix<double>& a);
+
+  long analyses() const;         // structures made
+  long reuses() const;           // structure requests answered from the cache
+  long orderings() const;        // orderings made
+  long ordering_reuses() const;  // ordering requests answered from the cache
 
  private:
   struct Entry {
     int n_states = 0;
     std::vector<BlockPattern::Block> blocks;
-    std::shared_ptr<const SparseStructure> structure;
+    std::shared_ptr<const SparseStructure> structure;   // null until asked for
+    std::shared_ptr<const SymmetricOrdering> ordering;  // null until asked for
   };
+  // The entry of the model's topology, made most recently used; nullptr when there is none.
+  Entry* find(const Model& model);    // under mutex_
+  Entry& insert(const Model& model);  // under mutex_: a new entry, evicting the oldest if full
   static constexpr size_t kCapacity = 8;
   mutable std::mutex mutex_;
   std::vector<Entry> entries_;  // most recently used last
-  long analyses_ = 0, reuses_ = 0;
+  long analyses_ = 0, reuses_ = 0, orderings_ = 0, ordering_reuses_ = 0;
 };
 
 }  // namespace beamrail

@@ -1,7 +1,8 @@
 // Designs of one topology share the sparse Jacobian structure and its KLU ordering: a sweep over
 // section sizes and lengths of a segmented cantilever analyses the topology once, on one thread
 // or several, and every design's responses equal those of the design evaluated on its own. The
-// static analysis's tangent (KLU on the same velocity-level pattern) shares it too.
+// static analysis's tangent (KLU on the same velocity-level pattern) shares it too, and modal
+// analyses share the fill-reducing ordering of their shift-invert factorization.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -129,6 +130,49 @@ TEST(DesignReuse, StaticAnalysesShareTheStructureToo) {
     }
   EXPECT_EQ(evaluator.structures().analyses(), 1);
   EXPECT_EQ(evaluator.structures().reuses(), 3);
+}
+
+// A sweep of modal analyses (about the initial state: no static analysis) shares one ordering of
+// K + mu M for its shift-invert factorizations and makes no Jacobian structure; each design's
+// frequencies equal its lone run's bit for bit, on one thread or two.
+TEST(DesignReuse, ModalAnalysesShareTheOrdering) {
+  std::string text = kStudy;
+  const std::string transient = text.substr(text.find(R"({"type": "transient")"));
+  text.replace(text.find(R"({"type": "transient")"), transient.find("}}],") + 2,
+               R"({"type": "modal", "modes": 3, "about": "initial"})");
+  const std::string peak =
+      R"({"quantity": "peak_displacement", "body": "tip", "direction": [0, -1, 0]})";
+  text.replace(text.find(peak), peak.size(), R"({"quantity": "frequency", "mode": 3})");
+  const std::string six = R"("segments": 6)";
+  text.replace(text.find(six), six.size(), R"("segments": 12)");  // 72 dofs: shift-invert
+  Diagnostics diag;
+  const auto study = load(diag, text);
+  ASSERT_TRUE(study) << diag.format() << text;
+  const DesignEvaluator evaluator(*study);
+  std::vector<std::vector<double>> designs;
+  for (double w : {0.008, 0.012})
+    for (double l : {0.9, 1.1}) designs.push_back({w, l});
+  std::vector<double> f3;
+  for (const auto& x : designs) {
+    const DesignOutcome o = evaluator.evaluate(x);
+    ASSERT_EQ(o.status, "ok") << o.message;
+    f3.push_back(o.responses.at(0));
+    EXPECT_EQ(o.responses.at(0), alone(evaluator, x));
+  }
+  for (size_t k = 1; k < designs.size(); ++k) EXPECT_NE(f3[k], f3[k - 1]);
+  EXPECT_EQ(evaluator.structures().orderings(), 1);
+  EXPECT_EQ(evaluator.structures().ordering_reuses(), static_cast<long>(designs.size()) - 1);
+  EXPECT_EQ(evaluator.structures().analyses(), 0);
+  std::vector<double> parallel(designs.size());
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 2; ++t)
+    threads.emplace_back([&, t] {
+      for (size_t k = static_cast<size_t>(t); k < designs.size(); k += 2)
+        parallel[k] = evaluator.evaluate(designs[k]).responses.at(0);
+    });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(evaluator.structures().orderings(), 1);
+  for (size_t k = 0; k < designs.size(); ++k) EXPECT_EQ(parallel[k], f3[k]);
 }
 
 // A design whose values change what the study reads from the scene beyond its numbers (gravity

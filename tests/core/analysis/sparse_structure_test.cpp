@@ -2,19 +2,24 @@
 // the Newton systems it is given (fresh factorization, refactorization with the old pivots, new
 // pivots when the old ones went bad, a singular matrix as a recoverable failure); the cache hands
 // one structure to every model of a topology and a new one to each other topology; a run with a
-// shared structure is the run without one, bit for bit.
+// shared structure is the run without one, bit for bit. The modal analysis's fill-reducing
+// ordering is SimplicialLDLT's own and is cached by topology too.
 #include "core/analysis/sparse_structure.hpp"
 
 #include <gtest/gtest.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
 #include <cmath>
 #include <random>
 #include <string>
+#include <thread>
 
 #include "core/analysis/klu_solver.hpp"
 #include "core/analysis/sundials_support.hpp"
+#include "core/model/forces.hpp"
+#include "core/model/generalized.hpp"
 #include "tests/support/reference_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 
@@ -172,6 +177,67 @@ TEST(SparseStructureCache, OneStructurePerTopology) {
   const long before = cache.analyses();
   cache.get(a);
   EXPECT_EQ(cache.analyses(), before + 1);
+}
+
+// The ordering symmetric_ordering reads off a pattern is the one Eigen's SimplicialLDLT chooses
+// for the matrix itself (so a factorization with the shared ordering is SimplicialLDLT's), and
+// it reads the pattern only: other values, even zeros stored, give the same permutation.
+TEST(SymmetricOrdering, IsSimplicialLdltsOwnAndReadsThePatternOnly) {
+  const Model model = scene_from_json(reference_cantilever(40));
+  Data data(model);
+  compute_tangent(model, data, 0.0, false);
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(model.n_dofs);
+  const Eigen::SparseMatrix<double> k = symmetric_stiffness(model, data, ones, nullptr);
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
+  ASSERT_EQ(ldlt.info(), Eigen::Success);
+  const SymmetricOrdering p = symmetric_ordering(k);
+  ASSERT_EQ(p.size(), k.rows());
+  EXPECT_EQ(p.indices(), ldlt.permutationP().indices());
+  // Not the chain's own order (else the comparison would show little).
+  EXPECT_NE(p.indices(), SymmetricOrdering(k.rows()).indices());
+  Eigen::SparseMatrix<double> other = k;
+  for (Eigen::Index i = 0; i < other.nonZeros(); ++i)
+    other.valuePtr()[i] = i % 3 == 0 ? 0.0 : std::sin(static_cast<double>(i));
+  EXPECT_EQ(symmetric_ordering(other).indices(), p.indices());
+}
+
+// The modal analysis's ordering is cached by topology like the structure, without making one (a
+// modal analysis needs neither the Jacobian's pattern nor KLU's analysis), and a structure made
+// later for the topology keeps it.
+TEST(SparseStructureCache, OneOrderingPerTopology) {
+  SparseStructureCache cache;
+  const auto stiffness = [](const Model& m) {
+    Data data(m);
+    compute_tangent(m, data, 0.0, false);
+    return symmetric_stiffness(m, data, Eigen::VectorXd::Ones(m.n_dofs), nullptr);
+  };
+  const Model a = scene_from_json(reference_cantilever(6));
+  const Model b = scene_from_json(reference_cantilever(6, 0.02, 2.5));
+  const auto pa = cache.ordering(a, stiffness(a));
+  const auto pb = cache.ordering(b, stiffness(b));
+  EXPECT_EQ(pa.get(), pb.get());
+  EXPECT_EQ(cache.orderings(), 1);
+  EXPECT_EQ(cache.ordering_reuses(), 1);
+  EXPECT_EQ(cache.analyses(), 0);
+  EXPECT_EQ(pa->indices(), symmetric_ordering(stiffness(b)).indices());
+  const auto sa = cache.get(a);
+  EXPECT_EQ(cache.analyses(), 1);
+  EXPECT_EQ(cache.ordering(b, stiffness(b)).get(), pa.get());
+  EXPECT_EQ(cache.get(b).get(), sa.get());
+  EXPECT_EQ(cache.orderings(), 1);
+  EXPECT_EQ(cache.ordering_reuses(), 2);
+  const Model c = scene_from_json(reference_cantilever(7));
+  EXPECT_NE(cache.ordering(c, stiffness(c)).get(), pa.get());
+  EXPECT_EQ(cache.orderings(), 2);
+  // Threads meeting a new topology at once all get the one ordering kept.
+  const Model d = scene_from_json(reference_cantilever(9));
+  const Eigen::SparseMatrix<double> kd = stiffness(d);
+  std::vector<std::shared_ptr<const SymmetricOrdering>> got(4);
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < got.size(); ++t)
+    threads.emplace_back([&, t] { got[t] = cache.ordering(d, kd); });
+  for (auto& t : threads) t.join();
+  for (const auto& p : got) EXPECT_EQ(p.get(), got[0].get());
 }
 
 TEST(SparseStructureCache, ARunWithASharedStructureIsTheRunWithout) {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "core/scene/json_reader.hpp"
-#include "optimizer/designs.hpp"
-#include "optimizer/evaluation.hpp"
+#include "optimizer/run/designs.hpp"
+#include "optimizer/run/evaluation.hpp"
 
 namespace beamrail {
 namespace {

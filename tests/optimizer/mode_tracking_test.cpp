@@ -1,4 +1,4 @@
-// Frequency responses that follow a mode through a design study (optimizer/responses.hpp): by
+// Frequency responses that follow a mode through a design study (optimizer/run/responses.hpp): by
 // shape ("track": the mode with the largest MAC against the study's own design's mode), by
 // dominant direction ("dominant"), and by number, on a tip body whose two bending modes cross
 // when the section's width passes its height. Each is compared with the closed form of the
@@ -11,7 +11,7 @@
 #include <string>
 
 #include "core/scene/json_reader.hpp"
-#include "optimizer/designs.hpp"
+#include "optimizer/run/designs.hpp"
 #include "tests/support/closed_forms.hpp"
 
 namespace beamrail {

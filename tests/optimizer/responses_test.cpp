@@ -7,9 +7,9 @@
 #include <cmath>
 #include <string>
 
-#include "optimizer/designs.hpp"
-#include "optimizer/evaluation.hpp"
-#include "optimizer/study.hpp"
+#include "optimizer/run/designs.hpp"
+#include "optimizer/run/evaluation.hpp"
+#include "optimizer/study/study.hpp"
 
 namespace beamrail {
 namespace {

@@ -1,4 +1,4 @@
-// Design sensitivities (optimizer/sensitivities.hpp, core/analysis/sensitivity.hpp):
+// Design sensitivities (optimizer/run/sensitivities.hpp, core/analysis/sensitivity.hpp):
 //  - closed forms: a tip cantilever's deflection F L^3 / (3 E I) and frequency against the load,
 //    E and the section; an Euler column's buckling factor, proportional to E; the derivatives of a
 //    repeated frequency (a square section) as the width grows, 3:1;
@@ -16,7 +16,7 @@
 #include <string>
 
 #include "core/scene/json_reader.hpp"
-#include "optimizer/designs.hpp"
+#include "optimizer/run/designs.hpp"
 #include "tests/support/closed_forms.hpp"
 
 namespace beamrail {

@@ -179,7 +179,7 @@ class Optimization {
 bool must_stop(const std::atomic<bool>& write_failed) { return stop_requested() || write_failed; }
 
 bool Optimization::usable(const DesignOutcome& o) const {
-  return o.status == "ok" &&
+  return o.status == Status::kOk &&
          (o.warnings == 0 || plan_.warned_designs == OptimizePlan::WarnedDesigns::kAccept);
 }
 
@@ -264,7 +264,7 @@ CsvRow Optimization::row(const Record& r) const {
   for (double v : r.outcome.responses) out.push_back(format_number(v));
   out.push_back(format_number(r.objective));
   out.push_back(r.feasible ? "1" : "0");
-  out.push_back(r.outcome.status);
+  out.push_back(status_name(r.outcome.status));
   out.push_back(std::to_string(r.outcome.warnings));
   out.push_back(format_number(r.outcome.wall_seconds));
   out.push_back(r.outcome.message);
@@ -344,14 +344,14 @@ std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
   for (long i = 0; i < n; ++i)
     if (!known[i]) {
       if (must_stop(write_failed_)) {
-        out[i].status = "interrupted";  // not evaluated
+        out[i].status = Status::kInterrupted;  // not evaluated
         out[i].responses.assign(study_.responses.size(), kNaN);
         continue;
       }
       out[i] = evaluator_.evaluate(xs[i], sensitivities ? &derivatives[i] : nullptr);
-      if (out[i].status == "interrupted") continue;
+      if (out[i].status == Status::kInterrupted) continue;
       ++simulated_;
-      if (out[i].status != "ok") ++failures_;
+      if (out[i].status != Status::kOk) ++failures_;
       if (numbers[i] > 0) ++done_;
       show_progress();
     }
@@ -362,7 +362,7 @@ std::optional<std::vector<DesignOutcome>> Optimization::outcomes(Start& start,
     for (size_t i = 0; i < xs.size(); ++i) {
       // An interrupted design is no result: neither cached nor in the history (a resumed run
       // evaluates it).
-      if (out[i].status == "interrupted") continue;
+      if (out[i].status == Status::kInterrupted) continue;
       cache_.try_emplace(xs[i], out[i]);
       if (sensitivities && !known[i]) record_derivatives(xs[i], out[i], derivatives[i]);
       if (numbers[i] < 0) continue;
@@ -395,7 +395,7 @@ void Optimization::record_derivatives(const Design& x, const DesignOutcome& o,
       if (sensitivity_warnings_.size() < 20) sensitivity_warnings_.insert(std::move(w));
   } else {
     jacobians_[x] = nullptr;
-    if (o.status != "ok") return;  // a failed design is a penalty: no gradient needed
+    if (o.status != Status::kOk) return;  // a failed design is a penalty: no gradient needed
     ++gradient_fallbacks_;
     if (fallback_reason_.empty()) fallback_reason_ = s.message;
   }
@@ -414,7 +414,7 @@ Optimization::with_derivatives(Start& start, const Design& x) {
   // on --resume): once more, with them; no new row.
   ResponseSensitivities s;
   const DesignOutcome again = evaluator_.evaluate(x, &s);
-  if (again.status == "interrupted") return std::make_pair((*o)[0], nullptr);
+  if (again.status == Status::kInterrupted) return std::make_pair((*o)[0], nullptr);
   ++simulated_;
   std::lock_guard<std::mutex> lock(mutex_);
   record_derivatives(x, again, s);
@@ -729,7 +729,7 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
     status = "infeasible";
     message = "no evaluated design satisfies every constraint";
     long warned = 0;
-    for (const Record& r : records_) warned += r.outcome.status == "ok" && r.outcome.warnings > 0;
+    for (const Record& r : records_) warned += r.outcome.status == Status::kOk && r.outcome.warnings > 0;
     if (warned > 0 && plan_.warned_designs == OptimizePlan::WarnedDesigns::kInfeasible)
       message += " (" + std::to_string(warned) +
                  " designs with warnings count as infeasible; their warnings are in the message "
@@ -912,7 +912,7 @@ int Optimization::run() {
     DesignOutcome o;
     for (size_t k = 0; k < nr; ++k)
       o.responses.push_back(std::strtod(r[2 + nv + k].c_str(), nullptr));
-    o.status = r[2 + nv + nr + 2];
+    o.status = status_from_name(r[2 + nv + nr + 2]).value_or(Status::kFailed);
     o.warnings = static_cast<int>(std::strtol(r[2 + nv + nr + 3].c_str(), nullptr, 10));
     o.wall_seconds = std::strtod(r[2 + nv + nr + 4].c_str(), nullptr);
     o.message = r[2 + nv + nr + 5];

@@ -42,16 +42,16 @@ int run_sensitivity(const Study& study, const RunSettings& settings) {
   std::vector<double> steps(nv, 0.0);
   std::string check_failure;
   const auto check_start = std::chrono::steady_clock::now();
-  if (plan.sensitivity.check && design.status == "ok") {
+  if (plan.sensitivity.check && design.status == Status::kOk) {
     for (size_t j = 0; j < nv; ++j) {
       steps[j] = plan.sensitivity.check_step * (x[j] != 0.0 ? std::abs(x[j]) : 1.0);
       std::vector<double> up = x, down = x;
       up[j] += steps[j];
       down[j] -= steps[j];
       const DesignOutcome u = evaluator.evaluate(up), d = evaluator.evaluate(down);
-      if (u.status != "ok" || d.status != "ok") {
+      if (u.status != Status::kOk || d.status != Status::kOk) {
         check_failure = "the check's design along \"" + plan.variables[j].name +
-                        "\" did not evaluate: " + (u.status != "ok" ? u.message : d.message);
+                        "\" did not evaluate: " + (u.status != Status::kOk ? u.message : d.message);
         continue;
       }
       for (size_t k = 0; k < nr; ++k)
@@ -86,8 +86,8 @@ int run_sensitivity(const Study& study, const RunSettings& settings) {
   }
 
   std::string status = "ok", message;
-  if (design.status != "ok") {
-    status = design.status == "interrupted" ? "interrupted" : "failed";
+  if (design.status != Status::kOk) {
+    status = design.status == Status::kInterrupted ? "interrupted" : "failed";
     message = "the study's design did not evaluate: " + design.message;
   } else if (!s.ok) {
     status = "failed";

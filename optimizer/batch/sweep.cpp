@@ -68,11 +68,11 @@ int run_sweep(const Study& study, const RunSettings& settings) {
     if (stop_requested() || write_failed) continue;
     const long i = todo[n];
     const DesignOutcome o = evaluator.evaluate(designs[i]);
-    if (o.status == "interrupted") continue;  // not a result: a resumed run evaluates it
+    if (o.status == Status::kInterrupted) continue;  // not a result: a resumed run evaluates it
     CsvRow row{std::to_string(i)};
     for (double x : designs[i]) row.push_back(format_number(x));
     for (double r : o.responses) row.push_back(format_number(r));
-    row.push_back(o.status);
+    row.push_back(status_name(o.status));
     row.push_back(std::to_string(o.warnings));
     row.push_back(format_number(o.wall_seconds));
     row.push_back(o.message);
@@ -82,7 +82,7 @@ int run_sweep(const Study& study, const RunSettings& settings) {
     }
     ++evaluated;
     if (o.warnings > 0) ++with_warnings;
-    if (o.status != "ok") ++failed;
+    if (o.status != Status::kOk) ++failed;
     progress.update(++finished, failed, "");
   }
   progress.finish();

@@ -171,8 +171,8 @@ int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
   if (vtk) options.vtk = &vtk_output.emplace(out / "vtk");
   Evaluation ev = evaluate(study, study.model, options);
   std::string vtk_error;
-  if (vtk_output && !vtk_output->finish(nullptr, &vtk_error) && ev.status == "ok")
-    ev.status = "failed", ev.message = vtk_error;
+  if (vtk_output && !vtk_output->finish(nullptr, &vtk_error) && ev.status == Status::kOk)
+    ev.status = Status::kFailed, ev.message = vtk_error;
   const nlohmann::json summary = evaluation_summary(study, study.model, ev);
   std::string error;
   if (!write_file_atomically(out / "summary.json", summary.dump(2) + "\n", &error)) {
@@ -180,7 +180,7 @@ int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
     return 1;
   }
   for (const std::string& w : ev.warnings) std::cerr << "warning: " << w << "\n";
-  if (ev.status == "interrupted") {
+  if (ev.status == Status::kInterrupted) {
     const int signal = stop_requested();
     std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
               << ev.message << "; the tables in " << out.string()
@@ -188,8 +188,8 @@ int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
                  "compute it all\n";
     return interrupted_exit_status(signal);
   }
-  if (ev.status != "ok") {
-    std::cerr << "beamrail: " << study.name << " " << ev.status << ": " << ev.message
+  if (ev.status != Status::kOk) {
+    std::cerr << "beamrail: " << study.name << " " << status_name(ev.status) << ": " << ev.message
               << "\n(partial results kept in " << out.string() << ")\n";
     return 1;
   }

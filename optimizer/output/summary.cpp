@@ -47,7 +47,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
   s["study"] = study.name;
   s["file"] = study.file;
   s["beamrail_version"] = kVersion;
-  s["status"] = ev.status;
+  s["status"] = status_name(ev.status);
   s["message"] = ev.message;
   nlohmann::json responses = nlohmann::json::object();
   for (size_t k = 0; k < study.responses.size(); ++k)

@@ -204,16 +204,16 @@ int draw_design(const Study& study, const DesignChoice& choice, const fs::path& 
   EvaluationOptions options;
   options.vtk = &vtk;
   const Evaluation ev = evaluate(*drawn, drawn->model, options);
-  design["status"] = ev.status;
+  design["status"] = status_name(ev.status);
   design["message"] = ev.message;
   std::string error;
   if (!vtk.finish(design, &error)) {
     std::cerr << "beamrail: " << error << "\n";
     return 1;
   }
-  if (ev.status != "ok") {
+  if (ev.status != Status::kOk) {
     std::cerr << "beamrail: the VTK files of " << describe(choice)
-              << " are incomplete: " << ev.status << ": " << ev.message << "\n";
+              << " are incomplete: " << status_name(ev.status) << ": " << ev.message << "\n";
     return 1;
   }
   if (!quiet)

@@ -20,13 +20,13 @@ DesignEvaluator::DesignEvaluator(const Study& study) : study_(study), base_(stud
   EvaluationOptions options;
   options.structure_cache = structures_.get();
   const Evaluation ev = beamrail::evaluate(study, study.model, options);
-  if (ev.status == "ok")
+  if (ev.status == Status::kOk)
     references_ = ev.tracked_shapes;
   else
     setup_failure_ =
         "the study's own design, whose mode shapes the tracked frequency responses follow, "
         "did not evaluate: " +
-        ev.status + ": " + ev.message;
+        std::string(status_name(ev.status)) + ": " + ev.message;
 }
 
 Json DesignEvaluator::document(const std::vector<double>& x) const {
@@ -121,7 +121,7 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,
     const auto design = build(x, diag);
     if (!design) {
       // The first problem names what the values broke (zero-length beam, point on the axis...).
-      out.status = "invalid";
+      out.status = Status::kInvalid;
       out.message = problems(diag);
     } else {
       EvaluationOptions options;
@@ -131,7 +131,7 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,
       options.keep_states = sensitivities != nullptr;
       const Evaluation ev = beamrail::evaluate(*design, design->model, options);
       if (sensitivities) {
-        if (ev.status == "ok") {
+        if (ev.status == Status::kOk) {
           *sensitivities = this->sensitivities(x, *design, ev);
         } else {
           *sensitivities = ResponseSensitivities();
@@ -146,7 +146,7 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,
         out.message += (out.message.empty() ? "" : "; ") + std::string("warning: ") + w;
     }
   } catch (const std::exception& e) {
-    out.status = "failed";
+    out.status = Status::kFailed;
     out.message = e.what();
   }
   for (char& c : out.message)  // a table row holds it on one line

@@ -17,7 +17,7 @@
 namespace beamrail {
 
 struct DesignOutcome {
-  std::string status = "ok";  // ok | failed | timeout | invalid | interrupted
+  Status status = Status::kOk;
   // One line: why the design failed (if it did), then "warning: ..." for each warning of its
   // analyses, separated by "; ".
   std::string message;

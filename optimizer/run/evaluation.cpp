@@ -53,7 +53,9 @@ class Runner {
     }
     const bool ok = report.ok;
     if (!ok) {
-      ev_.status = report.interrupted ? "interrupted" : report.timed_out ? "timeout" : "failed";
+      ev_.status = report.interrupted ? Status::kInterrupted
+                   : report.timed_out ? Status::kTimeout
+                                      : Status::kFailed;
       ev_.message = report.type + " analysis";
       if (study_.analyses.size() > 1 || spec.name != report.type)
         ev_.message += " \"" + spec.name + "\"";
@@ -486,7 +488,7 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
     Runner runner(study, model, options, ev, start);
     for (size_t i = 0; i < study.analyses.size(); ++i) {
       if (stop_requested()) {
-        ev.status = "interrupted";
+        ev.status = Status::kInterrupted;
         ev.message = "interrupted before the " + std::string(type_name(study.analyses[i].type)) +
                      " analysis \"" + study.analyses[i].name + "\"";
         break;
@@ -497,7 +499,7 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
     for (std::string& w : evaluate_expressions(study, ev.responses))
       ev.warnings.push_back(std::move(w));
   } catch (const std::exception& e) {
-    ev.status = "failed";
+    ev.status = Status::kFailed;
     ev.message = e.what();
   }
   ev.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

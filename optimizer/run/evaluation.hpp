@@ -13,6 +13,7 @@
 #include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
 #include "optimizer/run/responses.hpp"
+#include "optimizer/run/status.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
@@ -105,7 +106,7 @@ struct EvaluationStates {
 std::pair<Model, Model> buckling_models(const Model& model, const std::string& load_case);
 
 struct Evaluation {
-  std::string status = "ok";  // ok | failed | timeout | invalid | interrupted
+  Status status = Status::kOk;
   std::string message;
   std::vector<double> responses;  // one per study.responses, NaN when not computed
   std::vector<AnalysisReport> analyses;

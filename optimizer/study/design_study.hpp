@@ -104,11 +104,4 @@ struct DesignStudy {
   double max_seconds_per_design = 0.0;
 };
 
-struct Study;
-
-// Reads the "study" object; `study` supplies the responses and the document the pointers must
-// address. Reports every problem.
-std::optional<DesignStudy> read_design_study(const Json& value, const Where& where,
-                                             const Study& study, Diagnostics& diag);
-
 }  // namespace beamrail

@@ -146,6 +146,11 @@ extern const std::vector<std::string> kResponseQuantities;
 std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where, const Model* model,
                                           Diagnostics& diag);
 
+// Reads the "study" object (design_specs.cpp); `study` supplies the responses and the document the
+// pointers must address. Reports every problem.
+std::optional<DesignStudy> read_design_study(const Json& value, const Where& where,
+                                             const Study& study, Diagnostics& diag);
+
 // Reads an "integrator" object into io (analysis_specs.cpp).
 void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
                      IntegratorOptions& io);

@@ -809,6 +809,7 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
   s["warned_designs"] =
       plan_.warned_designs == OptimizePlan::WarnedDesigns::kAccept ? "accept" : "infeasible";
   s["designs_in_history"] = records_.size();
+  s["ranks"] = 1;  // an optimization runs in one process (rank 0 under mpirun)
   s["threads"] = threads_;
   s["wall_seconds"] = wall;
   s["evaluations_per_second"] = wall > 0 ? static_cast<double>(simulated_.load()) / wall : 0.0;

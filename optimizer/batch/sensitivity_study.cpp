@@ -117,6 +117,7 @@ int run_sensitivity(const Study& study, const RunSettings& settings) {
   summary["variables"] = variables;
   summary["responses"] = responses;
   summary["design_seconds"] = design_seconds;
+  summary["ranks"] = 1;
   summary["threads"] = threads;
   if (plan.sensitivity.check) {
     summary["check_seconds"] = check_seconds;

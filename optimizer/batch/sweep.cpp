@@ -1,12 +1,12 @@
 #include "optimizer/batch/sweep.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <iostream>
 #include <set>
 
 #include "core/analysis/stop_request.hpp"
+#include "optimizer/batch/executor.hpp"
 #include "optimizer/output/batch_table.hpp"
 #include "optimizer/run/designs.hpp"
 #include "optimizer/cli/interruption.hpp"
@@ -58,17 +58,16 @@ int run_sweep(const Study& study, const RunSettings& settings) {
     if (!done.count(i)) todo.push_back(i);
 
   Progress progress(static_cast<long>(designs.size()), settings.quiet);
-  std::atomic<long> finished(static_cast<long>(done.size())), failed(failures), evaluated(0),
-      with_warnings(warned);
-  std::atomic<bool> write_failed(false);
-  const int threads = batch_threads(settings, static_cast<long>(todo.size()));
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-  for (long n = 0; n < static_cast<long>(todo.size()); ++n) {
-    // After a stop request or a write error no design starts.
-    if (stop_requested() || write_failed) continue;
+  // The executor hands outcomes back one at a time: the counts need no lock.
+  long finished = static_cast<long>(done.size()), failed = failures, evaluated = 0,
+       with_warnings = warned;
+  const std::unique_ptr<BatchExecutor> executor =
+      make_executor(settings, static_cast<long>(todo.size()));
+  std::vector<Design> batch;
+  for (long i : todo) batch.push_back(designs[i]);
+  executor->evaluate(evaluator, batch, [&](long n, const DesignOutcome& o) {
+    if (o.status == Status::kInterrupted) return true;  // not a result: a resumed run evaluates it
     const long i = todo[n];
-    const DesignOutcome o = evaluator.evaluate(designs[i]);
-    if (o.status == Status::kInterrupted) continue;  // not a result: a resumed run evaluates it
     CsvRow row{std::to_string(i)};
     for (double x : designs[i]) row.push_back(format_number(x));
     for (double r : o.responses) row.push_back(format_number(r));
@@ -76,15 +75,14 @@ int run_sweep(const Study& study, const RunSettings& settings) {
     row.push_back(std::to_string(o.warnings));
     row.push_back(format_number(o.wall_seconds));
     row.push_back(o.message);
-    if (!table.append(row)) {
-      write_failed = true;
-      continue;
-    }
+    // After a write error no design starts.
+    if (!table.append(row)) return false;
     ++evaluated;
     if (o.warnings > 0) ++with_warnings;
     if (o.status != Status::kOk) ++failed;
     progress.update(++finished, failed, "");
-  }
+    return true;
+  });
   progress.finish();
   const int signal = stop_requested();
   const bool interrupted = signal != 0 && finished < static_cast<long>(designs.size());
@@ -101,19 +99,25 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   s["status"] = !written ? "failed" : interrupted ? "interrupted" : "ok";
   s["message"] = !written      ? error
                  : interrupted ? "interrupted by " + signal_name(signal) + " after " +
-                                     std::to_string(finished.load()) + " of " +
+                                     std::to_string(finished) + " of " +
                                      std::to_string(designs.size()) + " designs"
                                : "";
   s["warnings"] = study.input_warnings;
   s["designs"] = designs.size();
-  s["designs_in_table"] = finished.load();
-  s["evaluated_now"] = evaluated.load();
+  s["designs_in_table"] = finished;
+  s["evaluated_now"] = evaluated;
   s["resumed_from_table"] = done.size();
-  s["failed_or_invalid"] = failed.load();
-  s["designs_with_warnings"] = with_warnings.load();
-  s["threads"] = threads;
+  s["failed_or_invalid"] = failed;
+  s["designs_with_warnings"] = with_warnings;
+  s["ranks"] = executor->ranks();
+  s["threads"] = executor->threads();
+  const ExecutorStats stats = executor->stats();
+  if (executor->ranks() > 1) {
+    s["designs_per_rank"] = stats.designs_per_rank;
+    s["scheduler_seconds"] = stats.scheduler_seconds;
+  }
   s["wall_seconds"] = wall;
-  s["evaluations_per_second"] = wall > 0 ? static_cast<double>(evaluated.load()) / wall : 0.0;
+  s["evaluations_per_second"] = wall > 0 ? static_cast<double>(evaluated) / wall : 0.0;
   s["model"] = model_summary(study.model);
   std::string summary_error;
   const bool summarized =
@@ -129,12 +133,12 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   }
   if (interrupted) {
     std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
-              << finished.load() << " of " << designs.size() << " designs are in "
+              << finished << " of " << designs.size() << " designs are in "
               << samples.string() << "; continue with: " << settings.command << " --resume\n";
     return interrupted_exit_status(signal);
   }
-  std::cout << study.name << ": " << designs.size() << " designs (" << failed.load()
-            << " failed or invalid, " << with_warnings.load() << " with warnings) in " << wall
+  std::cout << study.name << ": " << designs.size() << " designs (" << failed
+            << " failed or invalid, " << with_warnings << " with warnings) in " << wall
             << " s -> " << settings.output.string() << "\n";
   return 0;
 }

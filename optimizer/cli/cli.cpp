@@ -1,5 +1,7 @@
 #include "optimizer/cli/cli.hpp"
 
+#include "optimizer/batch/mpi_job.hpp"
+
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -7,20 +9,20 @@
 #include <new>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/evaluation.hpp"
-#include "optimizer/interruption.hpp"
-#include "optimizer/optimize.hpp"
-#include "optimizer/output_folder.hpp"
-#include "optimizer/run_settings.hpp"
-#include "optimizer/sensitivity_study.hpp"
-#include "optimizer/study.hpp"
-#include "optimizer/summary.hpp"
-#include "optimizer/sweep.hpp"
-#include "optimizer/tables.hpp"
-#include "optimizer/version.hpp"
-#include "optimizer/vtk_design.hpp"
-#include "optimizer/vtk_output.hpp"
-#include "optimizer/work_precision.hpp"
+#include "optimizer/run/evaluation.hpp"
+#include "optimizer/cli/interruption.hpp"
+#include "optimizer/batch/optimize.hpp"
+#include "optimizer/output/output_folder.hpp"
+#include "optimizer/batch/run_settings.hpp"
+#include "optimizer/batch/sensitivity_study.hpp"
+#include "optimizer/study/study.hpp"
+#include "optimizer/output/summary.hpp"
+#include "optimizer/batch/sweep.hpp"
+#include "optimizer/output/tables.hpp"
+#include "optimizer/output/version.hpp"
+#include "optimizer/output/vtk_design.hpp"
+#include "optimizer/output/vtk_output.hpp"
+#include "optimizer/batch/work_precision.hpp"
 
 namespace beamrail {
 namespace {
@@ -171,8 +173,8 @@ int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
   if (vtk) options.vtk = &vtk_output.emplace(out / "vtk");
   Evaluation ev = evaluate(study, study.model, options);
   std::string vtk_error;
-  if (vtk_output && !vtk_output->finish(nullptr, &vtk_error) && ev.status == "ok")
-    ev.status = "failed", ev.message = vtk_error;
+  if (vtk_output && !vtk_output->finish(nullptr, &vtk_error) && ev.status == Status::kOk)
+    ev.status = Status::kFailed, ev.message = vtk_error;
   const nlohmann::json summary = evaluation_summary(study, study.model, ev);
   std::string error;
   if (!write_file_atomically(out / "summary.json", summary.dump(2) + "\n", &error)) {
@@ -180,7 +182,7 @@ int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
     return 1;
   }
   for (const std::string& w : ev.warnings) std::cerr << "warning: " << w << "\n";
-  if (ev.status == "interrupted") {
+  if (ev.status == Status::kInterrupted) {
     const int signal = stop_requested();
     std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
               << ev.message << "; the tables in " << out.string()
@@ -188,8 +190,8 @@ int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
                  "compute it all\n";
     return interrupted_exit_status(signal);
   }
-  if (ev.status != "ok") {
-    std::cerr << "beamrail: " << study.name << " " << ev.status << ": " << ev.message
+  if (ev.status != Status::kOk) {
+    std::cerr << "beamrail: " << study.name << " " << status_name(ev.status) << ": " << ev.message
               << "\n(partial results kept in " << out.string() << ")\n";
     return 1;
   }
@@ -240,6 +242,11 @@ int run(const RunArguments& args) {
   }
 
   const StopOnSignals signals;
+  // Under mpirun the other ranks evaluate a sweep's designs; anything else runs here alone.
+  const bool sweep = study->design && study->design->type == DesignStudy::Type::kSweep;
+  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !sweep)
+    std::cerr << "beamrail: only sweeps spread over MPI ranks so far; this study runs on rank 0 ("
+              << job->size() - 1 << " ranks stay idle)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {
     int status = 0;

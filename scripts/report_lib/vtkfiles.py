@@ -1,4 +1,4 @@
-"""Reads the VTK files beamrail writes (optimizer/vtk_output.hpp): .pvd collections whose frames
+"""Reads the VTK files beamrail writes (optimizer/output/vtk_output.hpp): .pvd collections whose frames
 are XML PolyData (.vtp) with raw appended data. A reader for that subset of the format, so that the
 report needs no VTK library; the tests read the same files with VTK's own readers."""
 

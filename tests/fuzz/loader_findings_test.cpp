@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/scene/json_reader.hpp"
-#include "optimizer/study.hpp"
+#include "optimizer/study/study.hpp"
 
 namespace beamrail {
 namespace {

@@ -25,7 +25,7 @@
 #include <system_error>
 
 #include "core/scene/diagnostics.hpp"
-#include "optimizer/study.hpp"
+#include "optimizer/study/study.hpp"
 #include "tests/fuzz/json_mutator.hpp"
 
 #ifndef BEAMRAIL_FUZZ_SCENES_DIR

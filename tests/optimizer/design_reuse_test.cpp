@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "core/scene/json_reader.hpp"
-#include "optimizer/designs.hpp"
-#include "optimizer/evaluation.hpp"
+#include "optimizer/run/designs.hpp"
+#include "optimizer/run/evaluation.hpp"
 
 namespace beamrail {
 namespace {
@@ -51,7 +51,7 @@ double alone(const DesignEvaluator& evaluator, const std::vector<double>& x) {
   EXPECT_TRUE(design) << diag.format();
   if (!design) return NAN;
   const Evaluation ev = evaluate(*design, design->model, {});
-  EXPECT_EQ(ev.status, "ok") << ev.message;
+  EXPECT_EQ(ev.status, Status::kOk) << ev.message;
   return ev.responses.at(0);
 }
 
@@ -68,7 +68,7 @@ TEST(DesignReuse, DesignsOfOneTopologyShareOneAnalysedStructure) {
   std::vector<double> peaks;
   for (const auto& x : designs) {
     const DesignOutcome o = evaluator.evaluate(x);
-    ASSERT_EQ(o.status, "ok") << o.message;
+    ASSERT_EQ(o.status, Status::kOk) << o.message;
     peaks.push_back(o.responses.at(0));
   }
   EXPECT_EQ(evaluator.structures().analyses(), 1);
@@ -113,7 +113,7 @@ TEST(DesignReuse, StaticAnalysesShareTheStructureToo) {
   for (double w : {0.008, 0.012})
     for (double l : {0.9, 1.1}) {
       const DesignOutcome o = evaluator.evaluate({w, l});
-      ASSERT_EQ(o.status, "ok") << o.message;
+      ASSERT_EQ(o.status, Status::kOk) << o.message;
       // Bending in x-y: I = height width^3 / 12, the sweep varies the width only.
       const double closed = l * l * l / (3.0 * 2.1e11 * 0.01 * w * w * w / 12.0);
       const double deflection = o.responses.at(0);
@@ -155,7 +155,7 @@ TEST(DesignReuse, ModalAnalysesShareTheOrdering) {
   std::vector<double> f3;
   for (const auto& x : designs) {
     const DesignOutcome o = evaluator.evaluate(x);
-    ASSERT_EQ(o.status, "ok") << o.message;
+    ASSERT_EQ(o.status, Status::kOk) << o.message;
     f3.push_back(o.responses.at(0));
     EXPECT_EQ(o.responses.at(0), alone(evaluator, x));
   }
@@ -198,7 +198,7 @@ TEST(DesignReuse, ValuesThatChangeTheAnalysesDefaultsReadTheWholeStudy) {
   std::vector<double> f;
   for (double g : {-9.81, 0.0, -30.0}) {
     const DesignOutcome o = evaluator.evaluate({g});
-    ASSERT_EQ(o.status, "ok") << o.message;
+    ASSERT_EQ(o.status, Status::kOk) << o.message;
     EXPECT_EQ(o.responses.at(0), alone(evaluator, {g})) << g;
     f.push_back(o.responses.at(0));
   }

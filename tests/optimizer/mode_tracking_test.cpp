@@ -1,4 +1,4 @@
-// Frequency responses that follow a mode through a design study (optimizer/responses.hpp): by
+// Frequency responses that follow a mode through a design study (optimizer/run/responses.hpp): by
 // shape ("track": the mode with the largest MAC against the study's own design's mode), by
 // dominant direction ("dominant"), and by number, on a tip body whose two bending modes cross
 // when the section's width passes its height. Each is compared with the closed form of the
@@ -11,7 +11,7 @@
 #include <string>
 
 #include "core/scene/json_reader.hpp"
-#include "optimizer/designs.hpp"
+#include "optimizer/run/designs.hpp"
 #include "tests/support/closed_forms.hpp"
 
 namespace beamrail {
@@ -61,7 +61,7 @@ TEST(ModeTracking, TrackedModeFollowsItsShapeThroughACrossing) {
   bool crossed = false;
   for (double w : {0.008, 0.0095, 0.0105, 0.012}) {
     const DesignOutcome o = evaluator.evaluate({w});
-    ASSERT_EQ(o.status, "ok") << o.message;
+    ASSERT_EQ(o.status, Status::kOk) << o.message;
     EXPECT_EQ(o.warnings, 0) << o.message;
     const double fy = bending_hz(kHeight * w * w * w / 12),
                  fz = bending_hz(w * std::pow(kHeight, 3) / 12);
@@ -85,12 +85,12 @@ TEST(ModeTracking, TrackedModeMissingFromTheComputedModesIsAWarning) {
   ASSERT_TRUE(study) << diag.format();
   const DesignEvaluator evaluator(*study);
   const DesignOutcome before = evaluator.evaluate({0.0095});
-  ASSERT_EQ(before.status, "ok") << before.message;
+  ASSERT_EQ(before.status, Status::kOk) << before.message;
   EXPECT_TRUE(std::isnan(before.responses[3]));  // no z-dominant mode among those computed
   EXPECT_NE(before.message.find("dominant direction z: compute more modes"), std::string::npos)
       << before.message;
   const DesignOutcome after = evaluator.evaluate({0.012});
-  ASSERT_EQ(after.status, "ok") << after.message;
+  ASSERT_EQ(after.status, Status::kOk) << after.message;
   EXPECT_NE(after.message.find("\"f1_tracked\" tracks mode 1 of the study's design, but no "
                                "computed mode resembles it (best MAC 0.000)"),
             std::string::npos)

@@ -3,7 +3,7 @@
 // never exceeds total and the ETA is never negative (it once read "200/8 designs ... ETA -7.7 s":
 // NLopt calls counted against designs), and it shows the best feasible design found so far (it
 // once read "best -" throughout).
-#include "optimizer/progress.hpp"
+#include "optimizer/batch/progress.hpp"
 
 #include <gtest/gtest.h>
 #include <pty.h>

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <string>
 
-#include "optimizer/designs.hpp"
-#include "optimizer/evaluation.hpp"
-#include "optimizer/study.hpp"
+#include "optimizer/run/designs.hpp"
+#include "optimizer/run/evaluation.hpp"
+#include "optimizer/study/study.hpp"
 
 namespace beamrail {
 namespace {
@@ -70,7 +70,7 @@ TEST(Responses, ExpressionsOverOtherResponsesInDependencyOrder) {
   doc["responses"]["z_mag"] = {{"quantity", "expression"}, {"expression", "sqrt(dy^2 + dz^2)"}};
   Evaluation ev;
   const auto v = evaluate_named(doc, &ev);
-  ASSERT_EQ(ev.status, "ok") << ev.message;
+  ASSERT_EQ(ev.status, Status::kOk) << ev.message;
   EXPECT_NE(v.at("dy"), 0.0);
   EXPECT_EQ(v.at("z_mag"), std::sqrt(v.at("dy") * v.at("dy") + v.at("dz") * v.at("dz")));
   EXPECT_EQ(v.at("a_worst"),
@@ -92,7 +92,7 @@ TEST(Responses, AnExpressionOfAResponseNotComputedIsNaNAndOneNotFiniteWarns) {
   // expression, without a warning of its own.
   doc["scene"]["loads"][0]["value"] = {0, 1e300, 1e300};
   v = evaluate_named(doc, &ev);
-  EXPECT_EQ(ev.status, "failed");
+  EXPECT_EQ(ev.status, Status::kFailed);
   EXPECT_TRUE(std::isnan(v.at("dy")));
   EXPECT_TRUE(std::isnan(v.at("inverse")));
   for (const std::string& w : ev.warnings) EXPECT_EQ(w.find("expression"), std::string::npos) << w;

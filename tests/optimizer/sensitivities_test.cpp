@@ -1,4 +1,4 @@
-// Design sensitivities (optimizer/sensitivities.hpp, core/analysis/sensitivity.hpp):
+// Design sensitivities (optimizer/run/sensitivities.hpp, core/analysis/sensitivity.hpp):
 //  - closed forms: a tip cantilever's deflection F L^3 / (3 E I) and frequency against the load,
 //    E and the section; an Euler column's buckling factor, proportional to E; the derivatives of a
 //    repeated frequency (a square section) as the width grows, 3:1;
@@ -16,7 +16,7 @@
 #include <string>
 
 #include "core/scene/json_reader.hpp"
-#include "optimizer/designs.hpp"
+#include "optimizer/run/designs.hpp"
 #include "tests/support/closed_forms.hpp"
 
 namespace beamrail {
@@ -36,7 +36,7 @@ struct Result {
 Result at(const DesignEvaluator& evaluator, const std::vector<double>& x) {
   Result r;
   r.outcome = evaluator.evaluate(x, &r.s);
-  EXPECT_EQ(r.outcome.status, "ok") << r.outcome.message;
+  EXPECT_EQ(r.outcome.status, Status::kOk) << r.outcome.message;
   EXPECT_TRUE(r.s.ok) << r.s.message;
   return r;
 }
@@ -233,8 +233,8 @@ TEST(Sensitivities, EveryResponseKindAgainstEveryVariableKindMatchesExtrapolated
       std::vector<double> up = x, down = x;
       up[j] += h, down[j] -= h;
       const DesignOutcome u = evaluator.evaluate(up), d = evaluator.evaluate(down);
-      EXPECT_EQ(u.status, "ok") << u.message;
-      EXPECT_EQ(d.status, "ok") << d.message;
+      EXPECT_EQ(u.status, Status::kOk) << u.message;
+      EXPECT_EQ(d.status, Status::kOk) << d.message;
       std::vector<double> out(nr);
       for (size_t k = 0; k < nr; ++k) out[k] = (u.responses[k] - d.responses[k]) / (2 * h);
       return out;
@@ -282,7 +282,7 @@ TEST(Sensitivities, ResponsesWithoutExactDerivativesSaySo) {
   const DesignEvaluator evaluator(*study);
   ResponseSensitivities s;
   const DesignOutcome o = evaluator.evaluate(values(*study), &s);
-  ASSERT_EQ(o.status, "ok") << o.message;
+  ASSERT_EQ(o.status, Status::kOk) << o.message;
   EXPECT_FALSE(s.ok);
   EXPECT_NE(s.message.find("\"dy\" (the peak of a transient) has no exact derivative"),
             std::string::npos)

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "optimizer/study.hpp"
+#include "optimizer/study/study.hpp"
 #include "tests/support/run_process.hpp"
 #include "tests/support/scene_builder.hpp"
 

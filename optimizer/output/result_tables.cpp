@@ -1,0 +1,133 @@
+#include "optimizer/output/result_tables.hpp"
+
+#include <stdexcept>
+
+#include "core/model/element_forces.hpp"
+#include "core/model/rotation.hpp"
+
+namespace beamrail {
+
+bool TimeseriesWriter::open(const std::filesystem::path& path, const Model& model,
+                            std::string* error) {
+  std::vector<std::string> header{"t"};
+  for (int i : model.free_bodies) {
+    if (model.bodies[i].generated) continue;
+    bodies_.push_back(i);
+    reference_.push_back(model.bodies[i].position);
+    for (const char* c : {".x", ".y", ".z", ".q0", ".q1", ".q2", ".q3"})
+      header.push_back(model.bodies[i].name + c);
+  }
+  header.push_back("energy");
+  flushed_ = std::chrono::steady_clock::now();
+  return table_.open(path, header, error, true);
+}
+
+void TimeseriesWriter::write(const TransientSample& sample, const Data& data) {
+  row_.clear();
+  row_.push_back(sample.t);
+  for (size_t k = 0; k < bodies_.size(); ++k) {
+    const int i = bodies_[k];
+    const Vec3 c = reference_[k] + data.pose[i].u;
+    const Vec4 q = data.q[i] / data.q[i].norm();
+    row_.insert(row_.end(), {c(0), c(1), c(2), q(0), q(1), q(2), q(3)});
+  }
+  row_.push_back(sample.energy());
+  table_.row(row_);
+  const auto now = std::chrono::steady_clock::now();
+  if (now - flushed_ >= kTimeseriesFlushInterval) {
+    table_.flush();
+    flushed_ = now;
+  }
+  if (!table_.good()) throw std::runtime_error(table_.error());
+}
+
+bool write_static_tables(const std::filesystem::path& directory, const std::string& prefix,
+                         const Model& model, const Data& data, std::string* error) {
+  CsvWriter displacements;
+  if (!displacements.open(directory / (prefix + "static_displacements.csv"),
+                          {"body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
+    return false;
+  for (int i : model.free_bodies) {
+    const Body& b = model.bodies[i];
+    const Vec3 d = data.pose[i].u;
+    const Vec3& r = data.rotation[i];
+    displacements.row({b.name, format_number(d(0)), format_number(d(1)), format_number(d(2)),
+                       format_number(r(0)), format_number(r(1)), format_number(r(2))});
+  }
+  CsvWriter forces;
+  if (!forces.open(directory / (prefix + "element_forces.csv"),
+                   {"element", "end", "fx", "fy", "fz", "mx", "my", "mz"}, error, true))
+    return false;
+  const auto rows = [&](const std::string& name, const EndForces& f) {
+    for (int end = 1; end <= 2; ++end) {
+      const Vec6& v = end == 1 ? f.end1 : f.end2;
+      std::vector<std::string> row{name, std::to_string(end)};
+      for (int c = 0; c < 6; ++c) row.push_back(format_number(v(c)));
+      forces.row(row);
+    }
+  };
+  for (size_t i = 0; i < model.beams.size(); ++i)
+    rows(model.beams[i].name, beam_end_forces(model, data, static_cast<int>(i)));
+  for (size_t i = 0; i < model.rails.size(); ++i)
+    rows(model.rails[i].name, rail_end_forces(model, data, static_cast<int>(i)));
+  return displacements.commit(error) && forces.commit(error);
+}
+
+bool write_modal_tables(const std::filesystem::path& directory, const std::string& prefix,
+                        const Model& model, const ModalResult& result, std::string* error) {
+  std::vector<std::string> header{"mode", "frequency_hz", "kind", "dominant"};
+  for (const char* column : {"participation_", "effective_mass_", "effective_mass_fraction_"})
+    for (const char* d : kDirectionNames) header.push_back(std::string(column) + d);
+  CsvWriter modes, shapes;
+  if (!modes.open(directory / (prefix + "modes.csv"), header, error, true) ||
+      !shapes.open(directory / (prefix + "mode_shapes.csv"),
+                   {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
+    return false;
+  int elastic = 0;
+  for (const Mode& mode : result.modes) {
+    const char* kind = mode.kind == Mode::Kind::kRigid      ? "rigid"
+                       : mode.kind == Mode::Kind::kUnstable ? "unstable"
+                                                            : "elastic";
+    const int number = mode.kind == Mode::Kind::kRigid ? 0 : ++elastic;
+    const int dominant = dominant_direction(mode, result);
+    std::vector<std::string> row{std::to_string(number), format_number(mode.frequency_hz), kind,
+                                 dominant >= 0 ? kDirectionNames[dominant] : "none"};
+    const Vec6 fraction = effective_mass_fraction(mode, result);
+    for (int d = 0; d < 6; ++d) row.push_back(format_number(mode.participation(d)));
+    for (int d = 0; d < 6; ++d)
+      row.push_back(format_number(mode.participation(d) * mode.participation(d)));
+    for (int d = 0; d < 6; ++d) row.push_back(format_number(fraction(d)));
+    modes.row(row);
+    if (mode.kind == Mode::Kind::kRigid) continue;
+    for (int k = 0; k < model.n_free(); ++k) {
+      std::vector<std::string> shape_row{std::to_string(number),
+                                         model.bodies[model.free_bodies[k]].name};
+      for (int c = 0; c < 6; ++c) shape_row.push_back(format_number(mode.shape(6 * k + c)));
+      shapes.row(shape_row);
+    }
+  }
+  return modes.commit(error) && shapes.commit(error);
+}
+
+bool write_buckling_tables(const std::filesystem::path& directory, const std::string& prefix,
+                           const Model& model, const BucklingResult& result, std::string* error) {
+  CsvWriter factors, shapes;
+  if (!factors.open(directory / (prefix + "buckling.csv"), {"mode", "factor", "nonlinearity"},
+                    error, true) ||
+      !shapes.open(directory / (prefix + "buckling_shapes.csv"),
+                   {"mode", "body", "dx", "dy", "dz", "rx", "ry", "rz"}, error, true))
+    return false;
+  for (size_t m = 0; m < result.modes.size(); ++m) {
+    const BucklingMode& mode = result.modes[m];
+    const std::string number = std::to_string(m + 1);
+    factors.row({number, format_number(mode.factor), format_number(mode.nonlinearity)});
+    for (int k = 0; k < model.n_free(); ++k) {
+      std::vector<std::string> row{number, model.bodies[model.free_bodies[k]].name};
+      for (int c = 0; c < 6; ++c) row.push_back(format_number(mode.shape(6 * k + c)));
+      shapes.row(row);
+    }
+  }
+  return factors.commit(error) && shapes.commit(error);
+}
+
+}  // namespace beamrail

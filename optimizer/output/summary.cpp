@@ -1,0 +1,147 @@
+#include "optimizer/output/summary.hpp"
+
+#include <cmath>
+#include <iostream>
+
+#include "optimizer/output/tables.hpp"
+#include "optimizer/output/version.hpp"
+
+namespace beamrail {
+
+nlohmann::json json_number(double x) {
+  if (!std::isfinite(x)) return nullptr;
+  return x;
+}
+
+int fail_before_designs(const Study& study, const std::filesystem::path& output,
+                        const std::string& type, const std::string& message) {
+  const nlohmann::json s{{"study", study.name},
+                         {"file", study.file},
+                         {"beamrail_version", kVersion},
+                         {"type", type},
+                         {"status", "failed"},
+                         {"message", message},
+                         {"warnings", study.input_warnings}};
+  std::string error;
+  if (!write_file_atomically(output / "summary.json", s.dump(2) + "\n", &error))
+    std::cerr << "beamrail: " << error << "\n";
+  std::cerr << "beamrail: " << study.name << " failed: " << message << "\n";
+  return 1;
+}
+
+nlohmann::json model_summary(const Model& model) {
+  int generated = 0;
+  for (const Body& b : model.bodies) generated += b.generated;
+  return {{"bodies", static_cast<int>(model.bodies.size()) - 1 - generated},
+          {"generated_bodies", generated},
+          {"free_bodies", model.n_free()},
+          {"beams", model.beams.size()},
+          {"rails", model.rails.size()},
+          {"loads", model.loads.size()},
+          {"states", model.n_states},
+          {"degrees_of_freedom", model.n_dofs}};
+}
+
+nlohmann::json evaluation_summary(const Study& study, const Model& model, const Evaluation& ev) {
+  nlohmann::json s;
+  s["study"] = study.name;
+  s["file"] = study.file;
+  s["beamrail_version"] = kVersion;
+  s["status"] = status_name(ev.status);
+  s["message"] = ev.message;
+  nlohmann::json responses = nlohmann::json::object();
+  for (size_t k = 0; k < study.responses.size(); ++k)
+    responses[study.responses[k].name] = json_number(ev.responses[k]);
+  s["responses"] = responses;
+  s["model"] = model_summary(model);
+  nlohmann::json analyses = nlohmann::json::array();
+  for (const AnalysisReport& a : ev.analyses) {
+    nlohmann::json j{{"name", a.name},
+                     {"type", a.type},
+                     {"status", a.ok            ? "ok"
+                                : a.interrupted ? "interrupted"
+                                : a.timed_out   ? "timeout"
+                                                : "failed"},
+                     {"message", a.message},
+                     {"wall_seconds", a.wall_seconds},
+                     {"tables", a.tables}};
+    if (!a.load_case.empty()) j["load_case"] = a.load_case;
+    if (a.type == "transient") {
+      j["integrator"] = a.integrator;
+      j["linear_solver"] = a.linear_solver;
+      j["steps"] = a.stats.steps;
+      j["rhs_evaluations"] = a.stats.rhs_evaluations;
+      j["jacobian_evaluations"] = a.stats.jacobian_evaluations;
+      j["nonlinear_iterations"] = a.stats.nonlinear_iterations;
+      j["nonlinear_failures"] = a.stats.nonlinear_failures;
+      j["error_test_failures"] = a.stats.error_test_failures;
+      j["t_reached"] = a.t_reached;
+      j["initial"] = a.initial;
+      j["energy_initial"] = json_number(a.energy_initial);
+      j["energy_final"] = json_number(a.energy_final);
+      j["energy_max_change"] = json_number(a.energy_max_change);
+      j["energy_max_relative_change"] = json_number(a.energy_max_relative_change);
+      if (const auto& v = a.verification)
+        j["verification"] = {
+            {"status", v->ok ? "ok" : "failed"},
+            {"message", v->message},
+            {"rtol", v->rtol},
+            {"atol", v->atol},
+            {"error", json_number(v->error)},
+            {"error_measure",
+             "largest distance between body centres of the run and of the tighter run, relative "
+             "to the largest distance a body moved"},
+            {"wall_seconds", v->stats.wall_seconds},
+            {"steps", v->stats.steps},
+            {"rhs_evaluations", v->stats.rhs_evaluations},
+            {"jacobian_evaluations", v->stats.jacobian_evaluations}};
+    }
+    if (a.statics) {
+      const StaticResult& r = *a.statics;
+      nlohmann::json st{{"converged", r.ok},
+                        {"iterations", r.iterations},
+                        {"load_steps", r.load_steps},
+                        {"residual_norm", json_number(r.residual_norm)},
+                        {"reference_force", json_number(r.reference_force)},
+                        {"rounding_floor", json_number(r.rounding_floor)},
+                        {"last_correction", json_number(r.correction)},
+                        {"singular_directions", r.singular_directions},
+                        {"negative_stiffness_directions", r.negative_directions},
+                        {"flutter_pairs", r.flutter_pairs},
+                        {"wall_seconds", r.wall_seconds}};
+      if (a.type == "static")
+        j.update(st);
+      else
+        j[a.type == "transient" ? "initial_equilibrium" : "equilibrium"] = st;
+    }
+    if (a.type == "modal") {
+      j["about"] = a.about;
+      j["eigensolver"] = a.eigensolver;
+      j["elastic_modes"] = a.modes;
+      j["rigid_body_modes"] = a.rigid_modes;
+      j["shift"] = json_number(a.shift);
+      j["largest_noise"] = json_number(a.noise);
+      j["stiffness_asymmetry"] = json_number(a.asymmetry);
+      j["eigenproblem"] = a.nonsymmetric ? "non-symmetric" : "symmetric";
+      nlohmann::json captured = nlohmann::json::object();
+      for (int d = 0; d < 6; ++d) captured[kDirectionNames[d]] = a.effective_mass_captured(d);
+      j["effective_mass_captured"] = captured;
+    }
+    if (a.type == "buckling") {
+      j["eigensolver"] = a.eigensolver;
+      nlohmann::json factors = nlohmann::json::array();
+      for (double f : a.factors) factors.push_back(json_number(f));
+      j["factors"] = factors;
+      j["positive_factors"] = a.positive_factors;
+    }
+    analyses.push_back(j);
+  }
+  s["analyses"] = analyses;
+  s["wall_seconds"] = ev.wall_seconds;
+  std::vector<std::string> warnings = study.input_warnings;
+  warnings.insert(warnings.end(), ev.warnings.begin(), ev.warnings.end());
+  s["warnings"] = warnings;
+  return s;
+}
+
+}  // namespace beamrail

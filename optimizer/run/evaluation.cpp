@@ -1,0 +1,509 @@
+#include "optimizer/run/evaluation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+
+#include "core/analysis/stop_request.hpp"
+#include "optimizer/run/expressions.hpp"
+#include "optimizer/run/responses.hpp"
+#include "optimizer/output/result_tables.hpp"
+#include "optimizer/output/tables.hpp"
+#include "optimizer/run/trajectory.hpp"
+#include "optimizer/output/vtk_output.hpp"
+
+namespace beamrail {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+class Runner {
+ public:
+  Runner(const Study& study, const Model& model, const EvaluationOptions& options, Evaluation& ev,
+         std::chrono::steady_clock::time_point start)
+      : study_(study), model_(model), options_(options), ev_(ev), start_(start) {
+    states_->analyses.resize(study.analyses.size());
+  }
+
+  std::shared_ptr<const EvaluationStates> states() const { return states_; }
+
+  // Runs analysis `index` of the study; false when it failed (the evaluation then stops).
+  bool run(int index) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    AnalysisReport report;
+    report.type = type_name(spec.type);
+    report.name = spec.name;
+    report.load_case = spec.load_case;
+    switch (spec.type) {
+      case AnalysisSpec::Type::kStatic:
+        run_static(index, report);
+        break;
+      case AnalysisSpec::Type::kModal:
+        run_modal(index, report);
+        break;
+      case AnalysisSpec::Type::kBuckling:
+        run_buckling(index, report);
+        break;
+      case AnalysisSpec::Type::kTransient:
+        run_transient_analysis(index, report);
+        break;
+    }
+    const bool ok = report.ok;
+    if (!ok) {
+      ev_.status = report.interrupted ? Status::kInterrupted
+                   : report.timed_out ? Status::kTimeout
+                                      : Status::kFailed;
+      ev_.message = report.type + " analysis";
+      if (study_.analyses.size() > 1 || spec.name != report.type)
+        ev_.message += " \"" + spec.name + "\"";
+      ev_.message += ": " + report.message;
+    }
+    ev_.analyses.push_back(std::move(report));
+    return ok;
+  }
+
+ private:
+  using Equilibrium = EvaluationStates::Equilibrium;
+
+  // The model with the loads of `load_case` (and those without a case): the study's own when
+  // every load applies.
+  const Model& case_model(const std::string& load_case) {
+    bool all = true;
+    for (const Load& load : model_.loads) all = all && applies_in_case(load, load_case);
+    if (all) return model_;
+    auto it = states_->case_models.find(load_case);
+    if (it == states_->case_models.end())
+      it = states_->case_models.emplace(load_case, model_for_case(model_, load_case)).first;
+    return it->second;
+  }
+
+  // The first static analysis of the study with this load case, or -1.
+  int listed_static(const std::string& load_case) const {
+    for (size_t i = 0; i < study_.analyses.size(); ++i)
+      if (study_.analyses[i].type == AnalysisSpec::Type::kStatic &&
+          study_.analyses[i].load_case == load_case)
+        return static_cast<int>(i);
+    return -1;
+  }
+
+  // The key of the equilibrium under the loads of `load_case` with the options of static analysis
+  // `listed` (or the defaults when -1), at the loads' time `time` (NaN: that of the options),
+  // solved once.
+  std::string equilibrium_key(const std::string& load_case, int listed, double time) {
+    StaticOptions options = listed >= 0 ? study_.analyses[listed].statics : StaticOptions{};
+    if (!std::isnan(time)) options.time = time;
+    const std::string key =
+        load_case + '\n' + std::to_string(listed) + '\n' + format_number(options.time);
+    if (states_->equilibria.count(key)) return key;
+    Equilibrium& e = states_->equilibria[key];
+    const Model& model = case_model(load_case);
+    options.structure_cache = structure_cache();
+    options.max_seconds = budget_left(options.max_seconds);
+    e.data = std::make_unique<Data>(model);
+    e.model = &model;
+    e.load_case = load_case;
+    e.result = solve_static(model, options, *e.data);
+    e.time = options.time;
+    return key;
+  }
+
+  Equilibrium& equilibrium(const std::string& load_case, int listed, double time) {
+    return states_->equilibria.at(equilibrium_key(load_case, listed, time));
+  }
+
+  void run_static(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    const std::string key = equilibrium_key(spec.load_case, index, kNaN);
+    const Equilibrium& e = states_->equilibria.at(key);
+    const StaticResult& r = e.result;
+    EvaluationStates::Analysis& state = states_->analyses[index];
+    state.model = e.model;
+    state.equilibrium = key;
+    state.time = e.time;
+    report.ok = r.ok;
+    report.timed_out = r.timed_out;
+    report.message = r.message;
+    report.wall_seconds = r.wall_seconds;
+    report.statics = r;
+    if (!r.ok) return;
+    add_warnings(r.warnings);
+    const Model& model = case_model(spec.load_case);
+    static_responses(study_, index, model, *e.data, ev_.responses);
+    state.ok = true;
+    if (!draw(report, [&](std::string* error) {
+          return options_.vtk->write_static(spec.name, model, *e.data, error);
+        }))
+      return;
+    if (!writes_tables()) return;
+    const std::string prefix = table_prefix(spec);
+    std::string error;
+    if (!write_static_tables(options_.output_directory, prefix, model, *e.data, &error)) {
+      report.ok = false;
+      report.message = error;
+    }
+    report.tables = {prefix + "static_displacements.csv", prefix + "element_forces.csv"};
+  }
+
+  void run_modal(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    report.about = spec.about_static ? "static" : "initial";
+    const Model& model = case_model(spec.load_case);
+    EvaluationStates::Analysis& state = states_->analyses[index];
+    state.data = std::make_unique<Data>(model);
+    Data& data = *state.data;
+    ModalOptions options = spec.modal;
+    if (spec.about_static) {
+      // The static analysis of this load case listed in the study, or one with default options.
+      state.equilibrium = equilibrium_key(spec.load_case, listed_static(spec.load_case), kNaN);
+      const Equilibrium& e = states_->equilibria.at(state.equilibrium);
+      report.statics = e.result;
+      if (!e.result.ok) {
+        report.timed_out = e.result.timed_out;
+        report.message = "no static equilibrium to linearize about: " + e.result.message;
+        return;
+      }
+      data.pose = e.data->pose;
+      data.q = e.data->q;
+      data.rotation = e.data->rotation;
+      options.time = e.time;
+    }
+    options.max_seconds = budget_left(options.max_seconds);
+    options.structure_cache = structure_cache();  // the designs share the ordering of K + mu M
+    for (const ResponseSpec& response : study_.responses)
+      options.keep_mass = options.keep_mass || (response.analysis == index && response.track);
+    const ModalResult r = solve_modal(model, options, data);
+    report.ok = r.ok;
+    report.timed_out = r.timed_out;
+    report.shift = r.shift;
+    for (const Mode& mode : r.modes) report.noise = std::max(report.noise, mode.noise);
+    report.message = r.message;
+    report.wall_seconds = r.wall_seconds;
+    report.eigensolver = r.solver;
+    report.rigid_modes = r.rigid_modes;
+    report.modes = static_cast<int>(r.modes.size()) - r.rigid_modes;
+    report.asymmetry = r.asymmetry;
+    report.nonsymmetric = r.nonsymmetric;
+    for (const Mode& mode : r.modes)
+      report.effective_mass_captured += effective_mass_fraction(mode, r);
+    add_warnings(r.warnings);
+    if (!r.ok) return;
+    std::vector<std::string> warnings;
+    std::vector<int> chosen;
+    modal_responses(study_, index, model, r, options_.mode_references, ev_.responses, warnings,
+                    &ev_.tracked_shapes, &chosen);
+    add_warnings(warnings);
+    keep_modes(state, model, options, r, chosen);
+    if (!draw(report, [&](std::string* error) {
+          return options_.vtk->write_modes(spec.name, model, data, r, error);
+        }))
+      return;
+    if (!writes_tables()) return;
+    const std::string prefix = table_prefix(spec);
+    std::string error;
+    if (!write_modal_tables(options_.output_directory, prefix, model, r, &error)) {
+      report.ok = false;
+      report.message = error;
+    }
+    report.tables = {prefix + "modes.csv", prefix + "mode_shapes.csv"};
+  }
+
+  // Buckling of a load case: its loads scaled, the loads without a case and gravity held (the
+  // reference is their equilibrium). Without a case: the loads without a case and gravity scaled
+  // about the unloaded initial state.
+  void run_buckling(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    const std::string& c = spec.load_case;
+    EvaluationStates::Analysis& state = states_->analyses[index];
+    auto [reference_model, scaled_model] = buckling_models(model_, c);
+    state.reference = std::make_unique<Model>(std::move(reference_model));
+    state.scaled = std::make_unique<Model>(std::move(scaled_model));
+    const Model* reference = state.reference.get();
+    const Model& scaled = *state.scaled;
+    state.data = std::make_unique<Data>(model_);
+    Data& data = *state.data;
+    BucklingOptions options = spec.buckling;
+    state.time = options.time;
+    if (!c.empty()) {
+      state.equilibrium = equilibrium_key("", listed_static(""), options.time);
+      const Equilibrium& e = states_->equilibria.at(state.equilibrium);
+      report.statics = e.result;
+      if (!e.result.ok) {
+        report.timed_out = e.result.timed_out;
+        report.message =
+            "no static equilibrium under the constant loads (those without a case, and "
+            "gravity): " +
+            e.result.message;
+        return;
+      }
+      data.pose = e.data->pose;
+      data.q = e.data->q;
+      data.rotation = e.data->rotation;
+    }
+    options.max_seconds = budget_left(options.max_seconds);
+    const BucklingResult r = solve_buckling(*reference, scaled, options, data);
+    report.ok = r.ok;
+    report.timed_out = r.timed_out;
+    report.message = r.message;
+    report.wall_seconds = r.wall_seconds;
+    report.eigensolver = r.solver;
+    report.positive_factors = r.positive_factors;
+    for (const BucklingMode& m : r.modes) report.factors.push_back(m.factor);
+    add_warnings(r.warnings);
+    if (!r.ok) return;
+    buckling_responses(study_, index, r, ev_.responses);
+    state.ok = true;
+    state.shapes.resize(model_.n_dofs, static_cast<Eigen::Index>(r.modes.size()));
+    for (size_t m = 0; m < r.modes.size(); ++m) {
+      state.eigenvalues.push_back(r.modes[m].factor);
+      state.shapes.col(static_cast<Eigen::Index>(m)) = r.modes[m].shape;
+    }
+    state.response_mode.assign(study_.responses.size(), -1);
+    for (size_t k = 0; k < study_.responses.size(); ++k) {
+      const ResponseSpec& rs = study_.responses[k];
+      if (rs.analysis == index && rs.quantity == ResponseSpec::Quantity::kBucklingFactor &&
+          rs.mode <= static_cast<int>(r.modes.size()))
+        state.response_mode[k] = rs.mode - 1;
+    }
+    if (!draw(report, [&](std::string* error) {
+          return options_.vtk->write_buckling(spec.name, model_, data, r, error);
+        }))
+      return;
+    if (!writes_tables()) return;
+    const std::string prefix = table_prefix(spec);
+    std::string error;
+    if (!write_buckling_tables(options_.output_directory, prefix, model_, r, &error)) {
+      report.ok = false;
+      report.message = error;
+    }
+    report.tables = {prefix + "buckling.csv", prefix + "buckling_shapes.csv"};
+  }
+
+  void run_transient_analysis(int index, AnalysisReport& report) {
+    const AnalysisSpec& spec = study_.analyses[index];
+    const Model& model = case_model(spec.load_case);
+    report.initial = spec.initial_static ? "static" : "scene";
+    TransientOptions options = budgeted(spec.transient);
+    if (spec.initial_static) {
+      // The equilibrium of the loads at t = 0, with the options of the case's static analysis.
+      const Equilibrium& e = equilibrium(spec.load_case, listed_static(spec.load_case), 0.0);
+      report.statics = e.result;
+      if (!e.result.ok) {
+        report.timed_out = e.result.timed_out;
+        report.message = "no static equilibrium at t = 0 to start from: " + e.result.message;
+        return;
+      }
+      options.initial_state.resize(model.n_states);
+      initial_state_at(model, *e.data, options.initial_state.data());
+      options.max_seconds = budget_left(spec.transient.max_seconds);
+    }
+    Data data(model);
+    std::vector<std::pair<size_t, PointTracker>> peaks;
+    for (size_t k = 0; k < study_.responses.size(); ++k)
+      if (study_.responses[k].quantity == ResponseSpec::Quantity::kPeakDisplacement &&
+          study_.responses[k].analysis == index) {
+        peaks.emplace_back(k, PointTracker(model, study_.responses[k]));
+        ev_.responses[k] = 0.0;
+      }
+    if (options_.vtk && !options_.vtk->begin_series(spec.name, model, &report.message)) return;
+    TimeseriesWriter table;
+    std::string table_error;
+    const bool tables = writes_tables();
+    const std::string file = table_file(spec, "timeseries.csv");
+    if (tables && !table.open(options_.output_directory / file, model, &table_error)) {
+      report.message = table_error;
+      return;
+    }
+    if (tables) report.tables = {file};
+
+    Trajectory trajectory = trajectory_of(model);
+    bool first = true;
+    const auto observer = [&](const TransientSample& s, const Data& d) {
+      if (first) report.energy_initial = s.energy(), first = false;
+      report.energy_final = s.energy();
+      report.energy_max_change =
+          std::max(report.energy_max_change, std::abs(s.energy() - report.energy_initial));
+      for (auto& [k, t] : peaks)
+        ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
+      if (tables) table.write(s, d);  // throws when the table cannot be written: the run fails
+      if (options_.vtk) options_.vtk->frame(s.t, d);  // throws likewise
+      if (spec.verify) trajectory.record(s, d);
+    };
+    const TransientResult result = run_transient(model, options, data, observer);
+    report.energy_max_relative_change =
+        report.energy_initial != 0.0 ? report.energy_max_change / std::abs(report.energy_initial)
+                                     : kNaN;
+    if (tables) table.commit(&table_error);
+    if (options_.vtk && table_error.empty()) options_.vtk->end_series(&table_error);
+    report.ok = result.ok;
+    report.timed_out = result.timed_out;
+    report.interrupted = result.interrupted;
+    report.message = result.message;
+    if (result.interrupted)
+      report.message = "interrupted at t = " + format_number(result.t_reached) + " s";
+    report.stats = result.stats;
+    report.integrator = options.integrator.method;
+    if (!options.integrator.table.empty()) report.integrator += " " + options.integrator.table;
+    report.linear_solver = result.linear_solver;
+    report.wall_seconds = result.stats.wall_seconds;
+    report.t_reached = result.t_reached;
+    add_warnings(result.warnings);
+    if (!table_error.empty() && report.message.find(table_error) == std::string::npos) {
+      report.message = report.ok ? table_error : report.message + "; " + table_error;
+      report.ok = false;
+    }
+    if (!result.ok)
+      for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
+    if (report.ok && spec.verify) {
+      report.verification = verify(model, options, trajectory);
+      if (stop_requested() && !report.verification->ok) {
+        report.ok = false;
+        report.interrupted = true;
+        report.message = "interrupted in the verification rerun";
+      }
+    }
+  }
+
+  // The elastic modes of a modal result and the mode each frequency response read (chosen: per
+  // response, an index into r.modes or -1).
+  static void keep_modes(EvaluationStates::Analysis& state, const Model& model,
+                         const ModalOptions& options, const ModalResult& r,
+                         const std::vector<int>& chosen) {
+    state.ok = true;
+    state.model = &model;
+    state.time = options.time;
+    state.load_factor = options.load_factor;
+    state.nonsymmetric = r.nonsymmetric;
+    std::vector<int> column(r.modes.size(), -1);
+    int n = 0;
+    for (size_t m = 0; m < r.modes.size(); ++m)
+      if (r.modes[m].kind != Mode::Kind::kRigid) column[m] = n++;
+    state.shapes.resize(model.n_dofs, n);
+    for (size_t m = 0; m < r.modes.size(); ++m)
+      if (column[m] >= 0) {
+        state.eigenvalues.push_back(r.modes[m].eigenvalue);
+        state.shapes.col(column[m]) = r.modes[m].shape;
+      }
+    state.response_mode.assign(chosen.size(), -1);
+    for (size_t k = 0; k < chosen.size(); ++k)
+      if (chosen[k] >= 0) state.response_mode[k] = column[chosen[k]];
+  }
+
+  bool writes_tables() const { return !options_.output_directory.empty(); }
+
+  // Writes the analysis's VTK files when asked for (write(&error)); false, with the analysis
+  // failed, when they cannot be written.
+  template <class Write>
+  bool draw(AnalysisReport& report, Write&& write) {
+    if (!options_.vtk) return true;
+    std::string error;
+    if (write(&error)) return true;
+    report.ok = false;
+    report.message = error;
+    return false;
+  }
+
+  static std::string table_prefix(const AnalysisSpec& spec) { return table_file(spec, ""); }
+
+  SparseStructureCache* structure_cache() {
+    return options_.structure_cache ? options_.structure_cache : &structures_;
+  }
+
+  // An analysis's own max_seconds (0: none) cut to what is left of the evaluation's budget.
+  double budget_left(double own) const {
+    if (options_.max_seconds <= 0.0) return own;
+    const double used =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double left = std::max(1e-3, options_.max_seconds - used);
+    return own > 0.0 ? std::min(own, left) : left;
+  }
+
+  // The run's options with max_seconds cut to what is left of the evaluation's budget.
+  TransientOptions budgeted(TransientOptions options) {
+    options.structure_cache = structure_cache();
+    options.max_seconds = budget_left(options.max_seconds);
+    return options;
+  }
+
+  // Reruns the transient at rtol and atol divided by ten and measures how far the run was from it.
+  Verification verify(const Model& model, const TransientOptions& options, const Trajectory& run) {
+    Verification v;
+    TransientOptions tight = budgeted(options);
+    tight.integrator.rtol /= 10.0;
+    tight.integrator.atol /= 10.0;
+    v.rtol = tight.integrator.rtol;
+    v.atol = tight.integrator.atol;
+    Data data(model);
+    Trajectory reference = trajectory_of(model);
+    const TransientResult r = run_transient(
+        model, tight, data,
+        [&reference](const TransientSample& s, const Data& d) { reference.record(s, d); });
+    v.ok = r.ok;
+    v.message = r.message;
+    v.stats = r.stats;
+    v.error = r.ok ? trajectory_error(run, reference) : kNaN;
+    return v;
+  }
+
+  void add_warnings(const std::vector<std::string>& warnings) {
+    for (const std::string& w : warnings)
+      if (std::find(ev_.warnings.begin(), ev_.warnings.end(), w) == ev_.warnings.end())
+        ev_.warnings.push_back(w);
+  }
+
+  const Study& study_;
+  const Model& model_;
+  const EvaluationOptions& options_;
+  Evaluation& ev_;
+  std::shared_ptr<EvaluationStates> states_ = std::make_shared<EvaluationStates>();
+  SparseStructureCache structures_;  // when the caller shares none
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+std::pair<Model, Model> buckling_models(const Model& model, const std::string& load_case) {
+  Model reference = load_case.empty() ? with_loads(
+                                            model, [](const Load&) { return false; }, false)
+                                      : model_for_case(model, "");
+  Model scaled = with_loads(
+      model,
+      [&](const Load& load) {
+        return load_case.empty() ? load.load_case.empty() : load.load_case == load_case;
+      },
+      load_case.empty());
+  return {std::move(reference), std::move(scaled)};
+}
+
+Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Evaluation ev;
+  ev.responses.assign(study.responses.size(), kNaN);
+  try {
+    for (size_t k = 0; k < study.responses.size(); ++k)
+      if (study.responses[k].quantity == ResponseSpec::Quantity::kMass)
+        ev.responses[k] = mass_response(model, study.responses[k]);
+    Runner runner(study, model, options, ev, start);
+    for (size_t i = 0; i < study.analyses.size(); ++i) {
+      if (stop_requested()) {
+        ev.status = Status::kInterrupted;
+        ev.message = "interrupted before the " + std::string(type_name(study.analyses[i].type)) +
+                     " analysis \"" + study.analyses[i].name + "\"";
+        break;
+      }
+      if (!runner.run(static_cast<int>(i))) break;
+    }
+    if (options.keep_states) ev.states = runner.states();
+    for (std::string& w : evaluate_expressions(study, ev.responses))
+      ev.warnings.push_back(std::move(w));
+  } catch (const std::exception& e) {
+    ev.status = Status::kFailed;
+    ev.message = e.what();
+  }
+  ev.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return ev;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,163 @@
+#include "optimizer/run/expressions.hpp"
+
+#include <muParser.h>
+
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <map>
+#include <mutex>
+
+#include "optimizer/study/study.hpp"
+#include "optimizer/output/tables.hpp"
+
+namespace beamrail {
+namespace {
+
+// Parsers are made and used one at a time: muparser keeps state shared between parsers (its
+// locale). An expression costs microseconds; designs evaluate in parallel around it.
+std::mutex& parser_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+// Every name the expression uses as a variable (muparser creates them through the factory).
+std::vector<std::string> used_names(const std::string& expression) {
+  std::lock_guard<std::mutex> lock(parser_mutex());
+  std::deque<double> storage;
+  mu::Parser parser;
+  parser.SetVarFactory(
+      [](const char*, void* data) -> double* {
+        auto* s = static_cast<std::deque<double>*>(data);
+        s->push_back(0.0);
+        return &s->back();
+      },
+      &storage);
+  parser.SetExpr(expression);
+  std::vector<std::string> names;
+  for (const auto& [name, value] : parser.GetUsedVar()) names.push_back(name);
+  return names;
+}
+
+int response_index(const Study& study, const std::string& name) {
+  for (size_t k = 0; k < study.responses.size(); ++k)
+    if (study.responses[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+}  // namespace
+
+void resolve_expressions(Study& study, Diagnostics& diag) {
+  std::vector<int> expressions;
+  for (size_t k = 0; k < study.responses.size(); ++k) {
+    ResponseSpec& r = study.responses[k];
+    if (r.quantity != ResponseSpec::Quantity::kExpression) continue;
+    const Where at = r.where / "expression";
+    std::vector<std::string> names;
+    try {
+      names = used_names(r.expression);
+    } catch (const mu::Parser::exception_type& e) {
+      diag.error(at.file, at.pointer, e.GetMsg() + " in \"" + r.expression + "\"");
+      continue;
+    }
+    bool ok = true;
+    r.inputs.clear();
+    for (const std::string& name : names) {
+      const int i = response_index(study, name);
+      if (i == static_cast<int>(k)) {
+        diag.error(at.file, at.pointer, "the expression reads its own response \"" + name + "\"");
+        ok = false;
+      } else if (i < 0) {
+        std::string known;
+        for (const ResponseSpec& s : study.responses)
+          if (s.name != r.name) known += (known.empty() ? "\"" : ", \"") + s.name + "\"";
+        diag.error(at.file, at.pointer,
+                   "\"" + name + "\" is no response of the study (its other responses: " +
+                       (known.empty() ? std::string("none") : known) + ")");
+        ok = false;
+      } else {
+        r.inputs.push_back(i);
+      }
+    }
+    if (ok) expressions.push_back(static_cast<int>(k));
+  }
+  // Each expression after those it reads; a cycle is reported at each expression on it.
+  std::map<int, int> state;  // 0 unvisited, 1 on the path, 2 done
+  study.expression_order.clear();
+  std::function<bool(int)> visit = [&](int k) {
+    if (state[k] == 2) return true;
+    if (state[k] == 1) return false;
+    state[k] = 1;
+    bool ok = true;
+    for (int i : study.responses[k].inputs)
+      if (study.responses[i].quantity == ResponseSpec::Quantity::kExpression) ok = visit(i) && ok;
+    state[k] = 2;
+    if (!ok) {
+      const Where at = study.responses[k].where / "expression";
+      diag.error(at.file, at.pointer,
+                 "the expression reads itself through other expressions (a cycle)");
+      return false;
+    }
+    study.expression_order.push_back(k);
+    return true;
+  };
+  for (int k : expressions) visit(k);
+}
+
+std::vector<std::string> evaluate_expressions(const Study& study, std::vector<double>& values) {
+  std::vector<std::string> warnings;
+  for (int k : study.expression_order) {
+    const ResponseSpec& r = study.responses[k];
+    bool inputs_finite = true, inputs_known = true;
+    for (int i : r.inputs) {
+      inputs_finite = inputs_finite && std::isfinite(values[i]);
+      inputs_known = inputs_known && !std::isnan(values[i]);
+    }
+    if (!inputs_known) {
+      values[k] = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    try {
+      std::lock_guard<std::mutex> lock(parser_mutex());
+      mu::Parser parser;
+      for (int i : r.inputs) parser.DefineVar(study.responses[i].name, &values[i]);
+      parser.SetExpr(r.expression);
+      values[k] = parser.Eval();
+    } catch (const mu::Parser::exception_type& e) {
+      values[k] = std::numeric_limits<double>::quiet_NaN();
+      warnings.push_back("expression \"" + r.name + "\": " + e.GetMsg());
+      continue;
+    }
+    if (inputs_finite && !std::isfinite(values[k])) {
+      std::string inputs;
+      for (int i : r.inputs)
+        inputs += (inputs.empty() ? "" : ", ") + study.responses[i].name + " = " +
+                  format_number(values[i]);
+      warnings.push_back("expression \"" + r.name + "\" is " + format_number(values[k]) +
+                         " where its inputs are finite (" + inputs + ")");
+    }
+  }
+  return warnings;
+}
+
+void chain_expression_derivatives(const Study& study, const std::vector<double>& values,
+                                  Eigen::Ref<Eigen::MatrixXd> jacobian) {
+  for (int k : study.expression_order) {
+    const ResponseSpec& r = study.responses[k];
+    jacobian.row(k).setZero();
+    std::vector<double> at = values;  // the parser varies one input at a time
+    std::lock_guard<std::mutex> lock(parser_mutex());
+    mu::Parser parser;
+    for (int i : r.inputs) parser.DefineVar(study.responses[i].name, &at[i]);
+    parser.SetExpr(r.expression);
+    for (int i : r.inputs) {
+      // muparser's five-point difference, step 1e-7 |x| (1e-10 at 0): ~1e-9 relative.
+      const double partial = parser.Diff(&at[i], values[i]);
+      at[i] = values[i];
+      jacobian.row(k) += partial * jacobian.row(i);
+    }
+  }
+}
+
+}  // namespace beamrail

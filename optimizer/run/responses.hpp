@@ -1,0 +1,64 @@
+// Computing the study's named responses from analysis results.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/analysis/modal_analysis.hpp"
+#include "core/model/data.hpp"
+#include "optimizer/study/study.hpp"
+
+namespace beamrail {
+
+// Total structural mass: declared body masses plus rho S l of every beam and rail with a density.
+double structural_mass(const Model& model);
+
+// A mass response: the structural mass, or that of its subset of bodies and elements.
+double mass_response(const Model& model, const ResponseSpec& spec);
+
+// Displacement along a direction of a body point, from the initial configuration.
+class PointTracker {
+ public:
+  PointTracker(const Model& model, const ResponseSpec& spec);
+  double value(const Data& data) const;
+
+ private:
+  int body_;
+  Vec3 offset_;         // body axes
+  Vec3 initial_lever_;  // point - centre in the initial configuration, global
+  Vec3 direction_;
+};
+
+// Fills the static responses (displacement, rotation, element_force, max_stress) of analysis
+// `analysis` (an index into study.analyses) from the equilibrium in data; others are left alone.
+void static_responses(const Study& study, int analysis, const Model& model, const Data& data,
+                      std::vector<double>& values);
+
+// A mode shape by body name (dc, dtheta of each free body): comparable between designs whose
+// bodies are numbered differently.
+using ShapeByBody = std::map<std::string, Vec6>;
+// Per frequency response (index into study.responses), the shape of the mode it reads.
+using ModeShapes = std::map<int, ShapeByBody>;
+
+// Fills the frequency responses of modal analysis `analysis` (of `model`): by mode number, by
+// dominant direction, or, for a tracked response with a reference shape in `references`, the mode
+// whose shape has the largest MAC against it. Warns (into `warnings`) of a dominant direction no
+// computed mode has and of a tracked mode that resembles its reference poorly (MAC below
+// kTrackedModeMac). The shapes of the modes tracked responses read go to `selected` (when given);
+// `chosen` (when given) receives per study response the index in result.modes of the mode it read,
+// or -1.
+void modal_responses(const Study& study, int analysis, const Model& model,
+                     const ModalResult& result, const ModeShapes* references,
+                     std::vector<double>& values, std::vector<std::string>& warnings,
+                     ModeShapes* selected, std::vector<int>* chosen = nullptr);
+
+// Below this MAC against its reference a tracked mode is reported with a warning.
+inline constexpr double kTrackedModeMac = 0.5;
+
+// Fills the buckling_factor responses of buckling analysis `analysis` (+infinity for a mode the
+// loads do not buckle).
+void buckling_responses(const Study& study, int analysis, const BucklingResult& result,
+                        std::vector<double>& values);
+
+}  // namespace beamrail

@@ -1,0 +1,253 @@
+#include "optimizer/run/sensitivities.hpp"
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numbers>
+
+#include "core/analysis/sensitivity.hpp"
+#include "optimizer/run/expressions.hpp"
+#include "optimizer/run/responses.hpp"
+
+namespace beamrail {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Relative step of the models' differences. Their quantities are smooth in p and evaluated to
+// rounding at one fixed state: the truncation error is ~ step^2, the rounding error ~ eps / step
+// times the cancellation in the element forces (measured in tests/optimizer/sensitivities_test:
+// 1e-4 agrees with extrapolated central differences of the responses to 1e-9 .. 1e-6 on a frame
+// where 1e-5 reaches only 1e-4 for derivatives 1e-4 of their response's relative scale).
+constexpr double kRelativeStep = 1e-4;
+
+bool same_topology(const Model& a, const Model& b) {
+  return a.n_dofs == b.n_dofs && a.bodies.size() == b.bodies.size() &&
+         a.beams.size() == b.beams.size() && a.rails.size() == b.rails.size() &&
+         a.loads.size() == b.loads.size() && a.free_bodies == b.free_bodies;
+}
+
+class Sensitivities {
+ public:
+  Sensitivities(const Study& design, const Evaluation& ev) : design_(design), ev_(ev) {}
+
+  ResponseSensitivities run(const std::vector<const Study*>& plus,
+                            const std::vector<const Study*>& minus, const std::vector<double>& h);
+
+ private:
+  // Fills the single column of out.jacobian with the derivatives along variable j; false (with
+  // out.message) when it cannot.
+  bool variable(int j, const Study& plus, const Study& minus, double h, ResponseSensitivities& out);
+
+  const Study& design_;
+  const Evaluation& ev_;
+  std::map<std::string, std::unique_ptr<EquilibriumSensitivity>> equilibria_;
+};
+
+// The model of `study` an analysis of `load_case` sees (as the evaluation's case_model).
+Model case_model_of(const Study& study, const std::string& load_case) {
+  return model_for_case(study.model, load_case);
+}
+
+ResponseSensitivities Sensitivities::run(const std::vector<const Study*>& plus,
+                                         const std::vector<const Study*>& minus,
+                                         const std::vector<double>& h) {
+  ResponseSensitivities out;
+  const int nr = static_cast<int>(design_.responses.size());
+  const int nv = static_cast<int>(h.size());
+  out.jacobian = Eigen::MatrixXd::Constant(nr, nv, kNaN);
+  if (!ev_.states) {
+    out.message = "the evaluation kept no states";
+    return out;
+  }
+  const EvaluationStates& states = *ev_.states;
+  // What has no exact derivative.
+  for (int k = 0; k < nr; ++k) {
+    const ResponseSpec& r = design_.responses[k];
+    if (std::isnan(ev_.responses[k])) continue;
+    if (r.quantity == ResponseSpec::Quantity::kPeakDisplacement) {
+      out.message =
+          "response \"" + r.name +
+          "\" (the peak of a transient) has no exact derivative: use \"gradient\": \"fd\"";
+      return out;
+    }
+    if (r.quantity == ResponseSpec::Quantity::kFrequency && r.analysis >= 0 &&
+        states.analyses[r.analysis].nonsymmetric) {
+      out.message = "response \"" + r.name +
+                    "\" is a frequency of a non-symmetric eigenproblem (torques of fixed "
+                    "direction): no exact derivative; use \"gradient\": \"fd\"";
+      return out;
+    }
+  }
+  // One factorization per equilibrium the responses depend on.
+  for (const auto& [key, e] : states.equilibria) {
+    if (!e.result.ok) continue;
+    auto s = std::make_unique<EquilibriumSensitivity>(*e.model, *e.data, e.time, 1.0);
+    equilibria_.emplace(key, std::move(s));
+  }
+  // The variables in parallel (each writes its own column, warnings and message); one thread
+  // when already inside a parallel batch.
+  std::vector<ResponseSensitivities> per(nv);
+  std::vector<char> done(nv, 0);
+#pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
+  for (int j = 0; j < nv; ++j) {
+    per[j].jacobian = Eigen::MatrixXd::Constant(nr, 1, kNaN);
+    done[j] = variable(j, *plus[j], *minus[j], h[j], per[j]);
+  }
+  for (int j = 0; j < nv; ++j) {
+    if (!done[j]) {
+      out.message = per[j].message;
+      out.jacobian.setConstant(kNaN);
+      return out;
+    }
+    out.jacobian.col(j) = per[j].jacobian.col(0);
+    for (std::string& w : per[j].warnings) out.warnings.push_back(std::move(w));
+  }
+  chain_expression_derivatives(design_, ev_.responses, out.jacobian);
+  for (int k = 0; k < nr; ++k)
+    if (std::isnan(ev_.responses[k])) out.jacobian.row(k).setConstant(kNaN);
+  out.ok = true;
+  return out;
+}
+
+bool Sensitivities::variable(int j, const Study& plus, const Study& minus, double h,
+                             ResponseSensitivities& out) {
+  if (!same_topology(plus.model, design_.model) || !same_topology(minus.model, design_.model)) {
+    out.message = "variable " + std::to_string(j + 1) +
+                  " changes the scene's bodies or elements (a segment count, a fixed flag): no "
+                  "derivative";
+    return false;
+  }
+  const EvaluationStates& states = *ev_.states;
+  const int nr = static_cast<int>(design_.responses.size());
+  auto column = out.jacobian.col(0);
+
+  // du/dp of each equilibrium, on its load case's models.
+  std::map<std::string, Eigen::VectorXd> v;
+  std::map<std::string, std::pair<Model, Model>> case_models;
+  const auto models_of = [&](const std::string& load_case) -> const std::pair<Model, Model>& {
+    auto it = case_models.find(load_case);
+    if (it == case_models.end())
+      it = case_models
+               .emplace(load_case, std::make_pair(case_model_of(plus, load_case),
+                                                  case_model_of(minus, load_case)))
+               .first;
+    return it->second;
+  };
+  const auto state_derivative = [&](const std::string& key) -> const Eigen::VectorXd* {
+    if (key.empty()) return nullptr;
+    auto it = v.find(key);
+    if (it != v.end()) return &it->second;
+    const EvaluationStates::Equilibrium& e = states.equilibria.at(key);
+    const EquilibriumSensitivity& s = *equilibria_.at(key);
+    if (!s.failure().empty()) {
+      out.message = s.failure();
+      return nullptr;
+    }
+    const auto& [mp, mm] = models_of(e.load_case);
+    return &v.emplace(key, s.state_derivative({&mp, &mm, h})).first->second;
+  };
+
+  for (size_t i = 0; i < design_.analyses.size(); ++i) {
+    const EvaluationStates::Analysis& a = states.analyses[i];
+    if (!a.ok) continue;
+    const AnalysisSpec& spec = design_.analyses[i];
+    const int index = static_cast<int>(i);
+    bool reads = false;
+    for (const ResponseSpec& r : design_.responses) reads = reads || r.analysis == index;
+    if (!reads) continue;
+    const Eigen::VectorXd* dv = state_derivative(a.equilibrium);
+    if (!a.equilibrium.empty() && !dv) return false;
+    const Eigen::VectorXd none;
+    const Eigen::VectorXd& du = dv ? *dv : none;
+    switch (spec.type) {
+      case AnalysisSpec::Type::kStatic: {
+        const auto& [mp, mm] = models_of(spec.load_case);
+        const EvaluationStates::Equilibrium& e = states.equilibria.at(a.equilibrium);
+        std::vector<double> up(nr, kNaN), down(nr, kNaN);
+        static_responses(plus, index, mp,
+                         moved_state(*e.model, *e.data, mp, Eigen::VectorXd(h * du)), up);
+        static_responses(minus, index, mm,
+                         moved_state(*e.model, *e.data, mm, Eigen::VectorXd(-h * du)), down);
+        for (int k = 0; k < nr; ++k)
+          if (design_.responses[k].analysis == index) column(k) = (up[k] - down[k]) / (2.0 * h);
+        break;
+      }
+      case AnalysisSpec::Type::kModal: {
+        const auto& [mp, mm] = models_of(spec.load_case);
+        const EigenvalueDerivatives d = eigenvalue_derivatives(
+            *a.model, *a.data, {&mp, &mm, h}, du, a.time, a.load_factor, a.eigenvalues, a.shapes);
+        for (int k = 0; k < nr; ++k) {
+          const int m = a.response_mode[k];
+          if (m < 0) continue;
+          // f = sqrt(lambda) / (2 pi): df = dlambda / (8 pi^2 f).
+          const double f = std::sqrt(a.eigenvalues[m]) / (2.0 * std::numbers::pi);
+          column(k) = d.values[m] / (8.0 * std::numbers::pi * std::numbers::pi * f);
+          if (d.crossing[m] == 1 || d.crossing[m] == 2)
+            out.warnings.push_back(
+                "frequency response \"" + design_.responses[k].name + "\" (mode " +
+                std::to_string(m + 1) + ") is " +
+                (d.crossing[m] == 2
+                     ? "on a crossing of modes (a repeated frequency): its derivative is the "
+                       "directional one as the variables grow"
+                     : "near a crossing of modes: its derivative changes quickly with the design"));
+        }
+        break;
+      }
+      case AnalysisSpec::Type::kBuckling: {
+        const auto [rp, sp] = buckling_models(plus.model, spec.load_case);
+        const auto [rm, sm] = buckling_models(minus.model, spec.load_case);
+        const EigenvalueDerivatives d =
+            buckling_factor_derivatives(*a.reference, *a.data, {&rp, &rm, h}, {&sp, &sm, h}, du,
+                                        a.time, a.eigenvalues, a.shapes);
+        for (int k = 0; k < nr; ++k) {
+          const int m = a.response_mode[k];
+          if (m < 0) continue;
+          column(k) = d.values[m];
+          if (d.crossing[m] == 2)
+            out.warnings.push_back("buckling factor \"" + design_.responses[k].name +
+                                   "\" is a repeated factor: its derivative is the "
+                                   "directional one as the variables grow");
+        }
+        break;
+      }
+      case AnalysisSpec::Type::kTransient:
+        break;  // peaks were refused above; nothing else reads a transient
+    }
+  }
+  for (int k = 0; k < nr; ++k)
+    if (design_.responses[k].quantity == ResponseSpec::Quantity::kMass)
+      column(k) = (mass_response(plus.model, plus.responses[k]) -
+                   mass_response(minus.model, minus.responses[k])) /
+                  (2.0 * h);
+  return true;
+}
+
+}  // namespace
+
+double sensitivity_step(double x, double scale) {
+  return kRelativeStep * (x != 0.0 ? std::abs(x) : (scale > 0.0 ? scale : 1.0));
+}
+
+ResponseSensitivities response_sensitivities(const Study& design, const Evaluation& ev,
+                                             const std::vector<const Study*>& plus,
+                                             const std::vector<const Study*>& minus,
+                                             const std::vector<double>& h) {
+  Sensitivities s(design, ev);
+  ResponseSensitivities out;
+  try {
+    out = s.run(plus, minus, h);
+  } catch (const std::exception& e) {
+    out = ResponseSensitivities();
+    out.message = std::string("the sensitivities failed: ") + e.what();
+  }
+  // One warning per text.
+  std::vector<std::string> unique;
+  for (std::string& w : out.warnings)
+    if (std::find(unique.begin(), unique.end(), w) == unique.end()) unique.push_back(std::move(w));
+  out.warnings = std::move(unique);
+  return out;
+}
+
+}  // namespace beamrail

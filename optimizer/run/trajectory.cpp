@@ -1,0 +1,36 @@
+#include "optimizer/run/trajectory.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace beamrail {
+
+Trajectory trajectory_of(const Model& model) {
+  Trajectory t;
+  for (int i : model.free_bodies)
+    if (!model.bodies[i].generated) t.bodies.push_back(i);
+  return t;
+}
+
+void Trajectory::record(const TransientSample& sample, const Data& data) {
+  times.push_back(sample.t);
+  for (int i : bodies) positions.push_back(data.pose[i].u);
+}
+
+double trajectory_error(const Trajectory& run, const Trajectory& reference) {
+  const size_t nb = reference.bodies.size();
+  const size_t samples = std::min(run.times.size(), reference.times.size());
+  if (samples == 0 || nb == 0 || run.bodies.size() != nb)
+    return std::numeric_limits<double>::quiet_NaN();
+  double error = 0.0, motion = 0.0;
+  for (size_t k = 0; k < reference.times.size(); ++k)
+    for (size_t b = 0; b < nb; ++b)
+      motion = std::max(motion, (reference.positions[k * nb + b] - reference.positions[b]).norm());
+  for (size_t k = 0; k < samples; ++k)
+    for (size_t b = 0; b < nb; ++b)
+      error = std::max(error, (run.positions[k * nb + b] - reference.positions[k * nb + b]).norm());
+  if (!(motion > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return error / motion;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,230 @@
+// Reading the "analyses" entries of a study: transient, static, modal and buckling.
+#include <cctype>
+#include <cmath>
+
+#include "optimizer/study/study.hpp"
+
+namespace beamrail {
+
+const std::vector<std::string> kAnalysisTypes = {"transient", "static", "modal", "buckling"};
+
+namespace {
+
+bool read_transient(ObjectReader& r, AnalysisSpec& a);
+
+}  // namespace
+
+void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
+                     IntegratorOptions& io) {
+  ObjectReader r(value, where, diag);
+  if (!r.is_object()) return;
+  if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk", "modal"}))
+    io.method = *m;
+  if (const auto t = r.string("table", false)) {
+    if (io.method != "dirk" && io.method != "erk")
+      r.error("table", "a Butcher table applies to the \"dirk\" and \"erk\" methods");
+    else
+      io.table = *t;
+  }
+  io.rtol = r.positive("rtol", false).value_or(io.rtol);
+  io.atol = r.positive("atol", false).value_or(io.atol);
+  if (const auto j = r.choice("jacobian", false, {"exact", "fd"}))
+    io.jacobian = *j == "exact" ? JacobianKind::kExact : JacobianKind::kFiniteDifference;
+  if (const auto s = r.choice("linear_solver", false, {"auto", "dense", "sparse"}))
+    io.linear_solver = *s == "dense"    ? LinearSolverKind::kDense
+                       : *s == "sparse" ? LinearSolverKind::kSparse
+                                        : LinearSolverKind::kAuto;
+  if (io.jacobian == JacobianKind::kFiniteDifference &&
+      io.linear_solver == LinearSolverKind::kSparse)
+    r.error("jacobian", "finite-difference Jacobians need the dense linear solver");
+  if (const auto q = r.integer("max_order", false, 1)) {
+    const int limit = io.method == "adams" ? 12 : 5;
+    if (io.method != "bdf" && io.method != "adams")
+      r.error("max_order", "applies to the \"bdf\" and \"adams\" methods");
+    else if (*q > limit)
+      r.error("max_order", io.method + " orders go from 1 to " + std::to_string(limit));
+    else
+      io.max_order = static_cast<int>(*q);
+  }
+  if (const auto d = r.boolean("stability_limit_detection", false)) {
+    if (io.method != "bdf") r.error("stability_limit_detection", "applies to the \"bdf\" method");
+    io.stability_limit_detection = *d;
+  }
+  io.max_step = r.positive("max_step", false).value_or(0.0);
+  io.initial_step = r.positive("initial_step", false).value_or(0.0);
+  io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
+  if (const auto about = r.choice("about", false, {"static", "initial"})) {
+    if (io.method != "modal")
+      r.error("about", "applies to the \"modal\" method");
+    else
+      io.about = *about;
+  }
+}
+
+namespace {
+
+bool read_transient(ObjectReader& r, AnalysisSpec& a) {
+  const auto t_end = r.positive("t_end", true);
+  const auto step = r.positive("output_step", false);
+  if (const Json* i = r.member("integrator", false))
+    read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
+  a.verify = r.boolean("verify", false).value_or(false);
+  a.transient.max_seconds = r.positive("max_seconds", false).value_or(0.0);
+  if (const auto initial = r.choice("initial", false, {"scene", "static"}))
+    a.initial_static = *initial == "static";
+  if (!t_end) return false;
+  a.transient.t_end = *t_end;
+  a.transient.output_step = step.value_or(*t_end / 100.0);
+  if (a.transient.output_step > *t_end) {
+    r.error("output_step", "must not exceed t_end");
+    return false;
+  }
+  if (*t_end / a.transient.output_step > 1e8) {
+    r.error("output_step", "more than 1e8 output rows requested");
+    return false;
+  }
+  return true;
+}
+
+bool has_harmonic_load(const Model* model) {
+  if (!model) return false;
+  for (const Load& load : model->loads)
+    if (load.time.type == TimeFunction::Type::kHarmonic) return true;
+  return false;
+}
+
+// The loads' time of a static or buckling analysis: "time", required when a load is harmonic.
+bool read_load_time(ObjectReader& r, const Model* model, double& time) {
+  if (const auto t = r.positive("time", false, true)) {
+    time = *t;
+  } else if (has_harmonic_load(model) && !r.member("time", false)) {
+    r.error("type", "the scene has harmonic loads, which have no final value: give \"time\"");
+    return false;
+  }
+  return true;
+}
+
+bool read_static(ObjectReader& r, const Model* model, AnalysisSpec& a) {
+  bool ok = read_load_time(r, model, a.statics.time);
+  a.statics.max_seconds = r.positive("max_seconds", false).value_or(0.0);
+  if (const Json* steps = r.member("load_steps", false)) {
+    if (steps->is_string()) {
+      if (steps->get<std::string>() != "auto") {
+        r.error("load_steps", "expected \"auto\" or a number of equal load steps");
+        ok = false;
+      }
+    } else if (const auto n = r.integer("load_steps", false, 1)) {
+      if (*n > 100000) {
+        r.error("load_steps", "at most 100000 load steps");
+        ok = false;
+      } else {
+        a.statics.load_steps = static_cast<int>(*n);
+      }
+    } else {
+      ok = false;
+    }
+  }
+  a.statics.tolerance = r.positive("tolerance", false).value_or(a.statics.tolerance);
+  if (const auto n = r.integer("max_iterations", false, 1))
+    a.statics.max_iterations = static_cast<int>(std::min(*n, 10000L));
+  return ok;
+}
+
+bool read_modal(ObjectReader& r, const Model* model, AnalysisSpec& a) {
+  if (const auto n = r.integer("modes", false, 1)) {
+    if (*n > 10000) {
+      r.error("modes", "at most 10000 modes");
+      return false;
+    }
+    a.modal.modes = static_cast<int>(*n);
+  }
+  bool loaded = model && model->gravity.norm() > 0.0;
+  if (model)
+    for (const Load& load : model->loads) loaded = loaded || applies_in_case(load, a.load_case);
+  const auto about = r.choice("about", false, {"static", "initial"});
+  a.about_static = about ? *about == "static" : loaded;
+  if (!a.about_static) a.modal.load_factor = 0.0;
+  if (const auto s = r.choice("solver", false, {"auto", "dense", "shift-invert"}))
+    a.modal.solver = *s == "dense"          ? EigenSolverKind::kDense
+                     : *s == "shift-invert" ? EigenSolverKind::kShiftInvert
+                                            : EigenSolverKind::kAuto;
+  a.modal.max_seconds = r.positive("max_seconds", false).value_or(0.0);
+  return true;
+}
+
+bool read_buckling(ObjectReader& r, const Model* model, AnalysisSpec& a) {
+  bool ok = read_load_time(r, model, a.buckling.time);
+  if (const auto n = r.integer("modes", false, 1)) {
+    if (*n > 10000) {
+      r.error("modes", "at most 10000 modes");
+      ok = false;
+    } else {
+      a.buckling.modes = static_cast<int>(*n);
+    }
+  }
+  if (const auto s = r.choice("solver", false, {"auto", "dense", "lanczos"}))
+    a.buckling.solver = *s == "dense"     ? EigenSolverKind::kDense
+                        : *s == "lanczos" ? EigenSolverKind::kShiftInvert
+                                          : EigenSolverKind::kAuto;
+  a.buckling.max_seconds = r.positive("max_seconds", false).value_or(0.0);
+  return ok;
+}
+
+// An analysis name: it names tables (<name>.<table>), so it must be a plain file-name part.
+bool valid_analysis_name(const std::string& name) {
+  if (name.empty() || name.size() > 64 || name[0] == '.') return false;
+  for (char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.')
+      return false;
+  return true;
+}
+
+}  // namespace
+
+std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where, const Model* model,
+                                          Diagnostics& diag) {
+  ObjectReader r(value, where, diag);
+  if (!r.is_object()) return std::nullopt;
+  AnalysisSpec a;
+  a.where = where;
+  const auto type = r.choice("type", true, kAnalysisTypes);
+  const auto name = r.string("name", false);
+  const auto load_case = r.string("load_case", false);
+  if (!type) {
+    r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "time", "load_steps",
+             "tolerance", "max_iterations", "modes", "about", "solver", "initial"});
+    return std::nullopt;
+  }
+  bool ok = true;
+  if (name && !valid_analysis_name(*name)) {
+    r.error("name",
+            "must be 1 to 64 letters, digits, '_', '-' or '.', not starting with '.' (it names "
+            "the analysis's tables)");
+    ok = false;
+  }
+  if (name) a.name = *name;
+  if (load_case) {
+    if (load_case->empty()) {
+      r.error("load_case", "must not be empty (omit it for the loads without a case)");
+      ok = false;
+    }
+    a.load_case = *load_case;
+  }
+  if (*type == "transient") {
+    a.type = AnalysisSpec::Type::kTransient;
+    ok = read_transient(r, a) && ok;
+  } else if (*type == "static") {
+    a.type = AnalysisSpec::Type::kStatic;
+    ok = read_static(r, model, a) && ok;
+  } else if (*type == "modal") {
+    a.type = AnalysisSpec::Type::kModal;
+    ok = read_modal(r, model, a) && ok;
+  } else {
+    a.type = AnalysisSpec::Type::kBuckling;
+    ok = read_buckling(r, model, a) && ok;
+  }
+  if (!ok) return std::nullopt;
+  return a;
+}
+
+}  // namespace beamrail

@@ -345,6 +345,8 @@ class Runner {
     report.integrator = options.integrator.method;
     if (!options.integrator.table.empty()) report.integrator += " " + options.integrator.table;
     report.linear_solver = result.linear_solver;
+    report.phases = result.phases;
+    report.phase_count = result.phase_count;
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);

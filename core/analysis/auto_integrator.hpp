@@ -1,0 +1,42 @@
+// The "auto" method of the transient analysis: it chooses per scene and per phase of the run.
+//
+// - At the start, the modal exponential integrator (core/analysis/modal_integrator.hpp)
+//   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless the
+//   scene is beyond its size limit or its damping is heavy enough to force more than
+//   kAutoDampingStepsPerPeriod steps per period of its slowest elastic mode (damping is explicit
+//   in the modal method): then bdf, as before auto.
+// - When a body turns more than kAutoRelinearizeRotation from the orientation it is linearized
+//   about, the modal method is linearized again about the current state (one eigenproblem) and
+//   the run goes on; when that happens more often than every kAutoMinStepsPerLinearization steps
+//   (a body spinning fast: relinearizing costs more than it saves), the rest of the run is
+//   integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps the fast modes it does not
+//   resolve).
+//
+// Every change is a MethodPhase of the result with its reason.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/analysis/integrators.hpp"
+
+namespace beamrail {
+
+// The rotation from the linearization at which auto relinearizes the modal method [rad].
+inline constexpr double kAutoRelinearizeRotation = 0.5;
+// Fewer modal steps than this between two linearizations, three times running: auto goes on with
+// the implicit method.
+inline constexpr long kAutoMinStepsPerLinearization = 10;
+// The implicit method auto falls back to mid-run.
+inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
+// Damping: the modal method's explicit treatment of stiffness-proportional damping beta limits
+// its step to about 2.5 / (beta w_max^2); auto takes bdf when that is below the period of the
+// slowest elastic mode divided by this.
+inline constexpr double kAutoDampingStepsPerPeriod = 100.0;
+
+// The auto integrator for the system in `context`, starting at (0, y0).
+std::unique_ptr<Integrator> make_auto_integrator(const IntegratorOptions& options,
+                                                 OdeContext& context, SUNContext sunctx,
+                                                 N_Vector y0, std::string* error);
+
+}  // namespace beamrail

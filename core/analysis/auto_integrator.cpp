@@ -52,7 +52,7 @@ class AutoIntegrator : public Integrator {
     const Model& model = c.model;
     if (model.n_free() == 0)
       return start_implicit("bdf", "", 0.0, y0, "the scene has no free body", error);
-    if (model.n_dofs > kModalIntegratorMaxDofs)
+    if (model.n_dofs > kModalIntegratorMaxDofs && !(o.max_frequency_hz > 0.0))
       return start_implicit("bdf", "", 0.0, y0,
                             std::to_string(model.n_free()) +
                                 " free bodies: beyond the modal method's limit of " +
@@ -76,14 +76,14 @@ class AutoIntegrator : public Integrator {
       double lowest = 0.0, highest = 0.0;
       modal_spectrum(*modal, &lowest, &highest);
       const double step = 2.5 / (beta * highest);
-      const double period =
-          lowest > 0.0 ? 2.0 * M_PI / std::sqrt(lowest) : std::numeric_limits<double>::infinity();
-      if (step < period / kAutoDampingStepsPerPeriod)
+      const double ratio = 0.5 * beta * std::sqrt(highest);
+      if (ratio > kAutoMaxDampingRatio)
         return start_implicit("bdf", "", 0.0, y0,
-                              "damping (beta " + number(beta) +
-                                  " s) would limit the modal method's explicit steps to " +
-                                  number(step) + " s, the slowest mode's period being " +
-                                  number(period) + " s",
+                              "damping (beta " + number(beta) + " s) damps the fastest mode (" +
+                                  number(std::sqrt(highest)) + " rad/s) at " + number(ratio) +
+                                  " of critical: the modal method's explicit damping would hold "
+                                  "its steps below " +
+                                  number(step) + " s; bdf steps over the decayed modes",
                               error);
       reason += "; its damping allows steps up to " + number(step) + " s";
     }

@@ -162,21 +162,27 @@ TEST(TransientAuto, ErrorFollowsTheTolerance) {
   }
 }
 
-// Damping is explicit in the modal method: where it would hold the steps below 1/100 of the
-// slowest mode's period, auto takes bdf, and says so; light damping keeps the modal method.
+// Damping is explicit in the modal method: where it damps the fastest mode beyond 0.1 of
+// critical, auto takes bdf, and says so; light damping keeps the modal method.
 TEST(TransientAuto, HeavyDampingTakesBdf) {
-  for (double beta : {1e-7, 1e-3}) {
+  // The fastest mode of the cantilever in 4 segments is near 4e4 rad/s: damping ratios 0.04, 0.4.
+  for (double beta : {2e-6, 2e-5}) {
     std::string json = reference_cantilever(4);
     const std::string section = R"("section": "sq",)";
-    json.replace(json.find(section), section.size(),
-                 section + R"( "damping": )" + std::to_string(beta) + ",");
+    char damping[64];
+    std::snprintf(damping, sizeof damping, R"( "damping": %.17g,)", beta);
+    json.replace(json.find(section), section.size(), section + damping);
     const Model model = scene_from_json(json);
+    ASSERT_EQ(model.beams.front().damping, beta);
     const TransientRun run = run_with(model, "auto", 0.01, 1e-3, 1e-6);
     ASSERT_TRUE(run.result.ok) << run.result.message;
     ASSERT_EQ(run.result.phases.size(), 1u);
-    std::printf("beta %g: %s: %s\n", beta, run.result.phases[0].method.c_str(),
-                run.result.phases[0].reason.c_str());
+    const std::string& reason = run.result.phases[0].reason;
+    std::printf("beta %g: %s: %s\n", beta, run.result.phases[0].method.c_str(), reason.c_str());
     EXPECT_EQ(run.result.phases[0].method, beta > 1e-5 ? "bdf" : "modal");
+    if (beta > 1e-5) {
+      EXPECT_NE(reason.find(" of critical"), std::string::npos) << reason;
+    }
   }
 }
 

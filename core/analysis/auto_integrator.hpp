@@ -4,12 +4,12 @@
 //   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless the
 //   scene is beyond its size limit or its fastest mode is damped beyond kAutoMaxDampingRatio
 //   (damping is explicit in the modal method): then bdf, as before auto.
-// - When a body turns more than kAutoRelinearizeRotation from the orientation it is linearized
-//   about, the modal method is linearized again about the current state (one eigenproblem) and
-//   the run goes on; when that happens more often than every kAutoMinStepsPerLinearization steps
-//   (a body spinning fast: relinearizing costs more than it saves), the rest of the run is
-//   integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps the fast modes it does not
-//   resolve).
+// - When a body turns more than kAutoRelinearizeRotation (less after cheap relinearizations,
+//   below) from the orientation it is linearized about, the modal method is linearized again about
+//   the current state (one eigenproblem) and the run goes on; when that happens more often than
+//   every kAutoMinStepsPerLinearization steps (a body spinning fast: relinearizing costs more than
+//   it saves), the rest of the run is integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps
+//   the fast modes it does not resolve).
 //
 // Every change is a MethodPhase of the result with its reason.
 #pragma once
@@ -23,6 +23,14 @@ namespace beamrail {
 
 // The rotation from the linearization at which auto relinearizes the modal method [rad].
 inline constexpr double kAutoRelinearizeRotation = 0.5;
+// The rotation limit halves after a linearization whose steps outnumbered the degrees of
+// freedom by more than 1 / this (relinearizing, ~n^3, is then cheap against the steps, ~n^2
+// each), down to kAutoMinRelinearizeRotation.
+inline constexpr double kAutoRelinearizeCostRatio = 0.03;
+inline constexpr double kAutoMinRelinearizeRotation = 0.02;
+// The first rotation limit is kAutoRelinearizeRotation from this many degrees of freedom on (100
+// bodies), proportionally less below, down to kAutoMinRelinearizeRotation.
+inline constexpr double kAutoFullRotationDofs = 600.0;
 // Fewer modal steps than this between two linearizations, three times running: auto goes on with
 // the implicit method.
 inline constexpr long kAutoMinStepsPerLinearization = 10;

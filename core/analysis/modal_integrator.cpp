@@ -262,6 +262,15 @@ class ModalExponential : public Integrator {
   SolverStats stats() const override { return stats_; }
 
   const Eigen::ArrayXd& eigenvalues() const { return lambda_; }
+  double step_size() const { return h_; }
+
+  // The largest rotation of a body from the linearization at the accepted state [rad].
+  double largest_rotation() const {
+    double largest = 0.0;
+    for (size_t b = 0; b < c0_.size(); ++b)
+      largest = std::max(largest, x_.block<3, 1>(kD * static_cast<Eigen::Index>(b) + 3, 0).norm());
+    return largest;
+  }
 
   std::string failure(int flag) const override {
     if (context_->timed_out) return "timeout: the run exceeded its max_seconds budget";
@@ -665,6 +674,12 @@ class ModalExponential : public Integrator {
           // Perhaps a trial state too far out: retry smaller before giving up.
           if (attempt >= 10) return fail_flag(sflag);
           err = 1e10;
+        } else if (sflag == kTooFar && attempt < 10 && largest_rotation() < 0.5 * max_rotation_) {
+          // A trial step that overshoots the rotation limit from well inside it: shorter, so that
+          // the run stops (or auto relinearizes) near the limit, not a long step before it.
+          ++stats_.error_test_failures;
+          h_ = 0.5 * h;
+          continue;
         } else {
           return fail_flag(sflag);
         }
@@ -753,6 +768,11 @@ bool modal_spectrum(const Integrator& integrator, double* smallest_positive, dou
         (*smallest_positive == 0.0 || lambda(i) < *smallest_positive))
       *smallest_positive = lambda(i);
   return true;
+}
+
+double modal_step_size(const Integrator& integrator) {
+  const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
+  return modal ? modal->step_size() : 0.0;
 }
 
 std::unique_ptr<Integrator> make_modal_integrator(const IntegratorOptions& options,

@@ -63,6 +63,9 @@ inline constexpr int kModalTooFar = -20;
 // largest [1/s^2]. False when `integrator` is not a modal integrator.
 bool modal_spectrum(const Integrator& integrator, double* smallest_positive, double* largest);
 
+// The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
+double modal_step_size(const Integrator& integrator);
+
 // The modal integrator for the system in `context`, starting at (t0, y0); the loads are those of
 // t0 in the linearization.
 std::unique_ptr<Integrator> make_modal_integrator(const IntegratorOptions& options,

@@ -53,6 +53,7 @@ struct AnalysisReport {
   // are kept) and how many phases there were.
   std::vector<MethodPhase> phases;
   long phase_count = 0;
+  double max_frequency_hz = 0.0;  // the band integrated (0: every mode) [Hz]
   std::optional<Verification> verification;
   // static (also the equilibrium a modal or buckling analysis is linearized about, or that a
   // transient starts from)

@@ -78,6 +78,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
         j["phases"] = phases;
         j["phase_count"] = a.phase_count;
       }
+      if (a.max_frequency_hz > 0.0) j["max_frequency_hz"] = a.max_frequency_hz;
       j["steps"] = a.stats.steps;
       j["rhs_evaluations"] = a.stats.rhs_evaluations;
       j["jacobian_evaluations"] = a.stats.jacobian_evaluations;

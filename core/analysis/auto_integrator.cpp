@@ -110,7 +110,14 @@ class AutoIntegrator : public Integrator {
       const long steps = current_->stats().steps;
       short_runs_ = steps < kAutoMinStepsPerLinearization ? short_runs_ + 1 : 0;
       before_ = sum(before_, current_->stats());
-      if (short_runs_ >= 3) {
+      const double turned = rotation_limit_;
+      if (short_runs_ >= 3 && rotation_limit_ < kAutoRelinearizeRotation) {
+        // A fast spin, not a stiff remainder: back to the full limit before giving up, and not
+        // down to this one again.
+        smallest_limit_ = std::min(kAutoRelinearizeRotation, 2.0 * rotation_limit_);
+        rotation_limit_ = kAutoRelinearizeRotation;
+        short_runs_ = 0;
+      } else if (short_runs_ >= 3) {
         std::string error;
         if (!start_implicit("dirk", kAutoImplicitTable, *t, y,
                             "relinearizing every " + std::to_string(steps) + " steps (body " + who +
@@ -122,10 +129,9 @@ class AutoIntegrator : public Integrator {
       // Relinearizing (a dense eigenproblem, ~n^3) cheap against the phase's steps (~n^2 each):
       // sooner next time, which lets the remainder the modal method treats explicitly stay
       // small (a stiff hinge swinging: 98,663 steps for 0.3 s at 0.5 rad, 17,207 at 0.02).
-      const double turned = rotation_limit_;
       const double dofs = static_cast<double>(context_->model.n_dofs);
-      if (dofs < kAutoRelinearizeCostRatio * static_cast<double>(steps))
-        rotation_limit_ = std::max(kAutoMinRelinearizeRotation, 0.5 * rotation_limit_);
+      if (short_runs_ == 0 && dofs < kAutoRelinearizeCostRatio * static_cast<double>(steps))
+        rotation_limit_ = std::max(smallest_limit_, 0.5 * rotation_limit_);
       std::string why;
       IntegratorOptions m = modal_options();
       m.about = "initial";
@@ -215,9 +221,10 @@ class AutoIntegrator : public Integrator {
   std::unique_ptr<Integrator> current_;
   bool modal_ = false;
   int short_runs_ = 0;  // consecutive linearizations that lasted few steps
-  double rotation_limit_ = kAutoRelinearizeRotation;  // of the current linearization [rad]
-  SolverStats before_;                                // of the phases before the current one
-  std::string failure_;                               // why auto itself failed (kAutoFailed)
+  double rotation_limit_ = kAutoRelinearizeRotation;     // of the current linearization [rad]
+  double smallest_limit_ = kAutoMinRelinearizeRotation;  // the limit halves down to this
+  SolverStats before_;                                   // of the phases before the current one
+  std::string failure_;                                  // why auto itself failed (kAutoFailed)
   std::vector<MethodPhase> first_;
   MethodPhase last_;
   long count_ = 0;

@@ -31,8 +31,9 @@ inline constexpr double kAutoMinRelinearizeRotation = 0.02;
 // The first rotation limit is kAutoRelinearizeRotation from this many degrees of freedom on (100
 // bodies), proportionally less below, down to kAutoMinRelinearizeRotation.
 inline constexpr double kAutoFullRotationDofs = 600.0;
-// Fewer modal steps than this between two linearizations, three times running: auto goes on with
-// the implicit method.
+// Fewer modal steps than this between two linearizations, three times running: auto goes back
+// to kAutoRelinearizeRotation (no lower than twice the limit that ran short), and at that limit
+// goes on with the implicit method.
 inline constexpr long kAutoMinStepsPerLinearization = 10;
 // The implicit method auto falls back to mid-run.
 inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";

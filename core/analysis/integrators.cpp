@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "core/analysis/auto_integrator.hpp"
 #include "core/analysis/klu_solver.hpp"
 #include "core/analysis/modal_integrator.hpp"
 
@@ -370,6 +371,7 @@ std::unique_ptr<Integrator> make_integrator(const IntegratorOptions& options, Od
   if (options.method == "dirk") return build<ArkodeImplicit>(options, context, sunctx, y0, error);
   if (options.method == "erk") return build<ArkodeExplicit>(options, context, sunctx, y0, error);
   if (options.method == "modal") return make_modal_integrator(options, context, y0, error);
+  if (options.method == "auto") return make_auto_integrator(options, context, sunctx, y0, error);
   *error = "unknown integrator method \"" + options.method + "\"";
   return nullptr;
 }

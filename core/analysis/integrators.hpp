@@ -28,6 +28,11 @@ class Integrator {
   std::string linear_solver = "none";
   long nnz = 0;                       // stored Jacobian entries (sparse)
   std::vector<std::string> warnings;  // for the run's result (set up at construction)
+  // The phases so far (auto switches methods and relinearizes; others have none) and their count.
+  virtual std::vector<MethodPhase> phases(long* count) const {
+    *count = 0;
+    return {};
+  }
 };
 
 // Builds the integrator of options.method for the system in `context`, starting at (0, y0).

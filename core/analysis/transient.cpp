@@ -119,6 +119,10 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     }
     result.t_reached = t;
     result.stats = integrator->stats();
+    result.phases = integrator->phases(&result.phase_count);
+    for (const std::string& w : integrator->warnings)  // auto's arrive during the run
+      if (std::find(result.warnings.begin(), result.warnings.end(), w) == result.warnings.end())
+        result.warnings.push_back(w);
   } catch (const std::exception& e) {
     result.ok = false;
     result.message = e.what();

@@ -26,10 +26,12 @@ inline constexpr const char* kDefaultErkTable = "DORMAND_PRINCE_7_4_5";
 inline constexpr long kSparseStateThreshold = 26;
 
 struct IntegratorOptions {
-  std::string method = "bdf";  // bdf | adams (CVODE), dirk | erk (ARKODE)
-  std::string table;           // dirk/erk: ARKODE Butcher table name ("" = default)
-  double rtol = 1e-6;          // relative tolerance
-  double atol = 1e-9;          // absolute tolerance (states in m, -, m/s, rad/s)
+  // bdf | adams (CVODE), dirk | erk (ARKODE), modal, auto (core/analysis/auto_integrator.hpp).
+  // A study's transient defaults to auto (optimizer/analysis_specs.cpp); this struct to bdf.
+  std::string method = "bdf";
+  std::string table;   // dirk/erk: ARKODE Butcher table name ("" = default)
+  double rtol = 1e-6;  // relative tolerance
+  double atol = 1e-9;  // absolute tolerance (states in m, -, m/s, rad/s)
   JacobianKind jacobian = JacobianKind::kExact;
   LinearSolverKind linear_solver = LinearSolverKind::kAuto;
   int max_order = 5;                       // BDF order limit 1..5 (Adams: 1..12)
@@ -41,6 +43,12 @@ struct IntegratorOptions {
   // t = 0), "initial" (the initial state), "" (static when that equilibrium is found within
   // kModalIntegratorMaxRotation of the initial state, else initial, with a warning).
   std::string about;
+  // modal: the rotation from the linearization past which the run stops [rad]; 0:
+  // kModalIntegratorMaxRotation. Set by auto, which relinearizes there.
+  double max_rotation = 0.0;
+  // modal, auto: the band integrated [Hz]; the modes above it are quasi-static (their static
+  // response kept, their dynamics dropped). 0: every mode.
+  double max_frequency_hz = 0.0;
 };
 
 struct TransientOptions {
@@ -73,6 +81,14 @@ struct SolverStats {
   long error_test_failures = 0;
 };
 
+// One phase of a run: from time t on, `method` ran, chosen for `reason` (auto; other methods have
+// one phase).
+struct MethodPhase {
+  double t = 0.0;
+  std::string method;  // "modal", "modal (relinearized)", "bdf", "dirk ESDIRK547L2SA2_7_4_5"
+  std::string reason;
+};
+
 struct TransientResult {
   bool ok = false;
   bool timed_out = false;      // stopped by max_seconds
@@ -83,7 +99,12 @@ struct TransientResult {
   double t_reached = 0.0;      // last time integrated to [s]
   SolverStats stats;
   std::vector<std::string> warnings;
+  // The phases of the run (auto: the first kMaxRecordedPhases, then the last), and how many there
+  // were in all.
+  std::vector<MethodPhase> phases;
+  long phase_count = 0;
 };
+inline constexpr size_t kMaxRecordedPhases = 20;
 
 using TransientObserver = std::function<void(const TransientSample&, const Data&)>;
 

@@ -69,6 +69,16 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
     if (a.type == "transient") {
       j["integrator"] = a.integrator;
       j["linear_solver"] = a.linear_solver;
+      if (!a.phases.empty()) {
+        nlohmann::json phases = nlohmann::json::array();
+        for (const MethodPhase& p : a.phases)
+          phases.push_back({{"t", p.t}, {"method", p.method}, {"reason", p.reason}});
+        j["method"] = a.phases.front().method;
+        j["method_reason"] = a.phases.front().reason;
+        j["phases"] = phases;
+        j["phase_count"] = a.phase_count;
+      }
+      if (a.max_frequency_hz > 0.0) j["max_frequency_hz"] = a.max_frequency_hz;
       j["steps"] = a.stats.steps;
       j["rhs_evaluations"] = a.stats.rhs_evaluations;
       j["jacobian_evaluations"] = a.stats.jacobian_evaluations;

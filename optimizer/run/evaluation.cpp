@@ -347,6 +347,9 @@ class Runner {
     report.integrator = options.integrator.method;
     if (!options.integrator.table.empty()) report.integrator += " " + options.integrator.table;
     report.linear_solver = result.linear_solver;
+    report.phases = result.phases;
+    report.phase_count = result.phase_count;
+    report.max_frequency_hz = options.integrator.max_frequency_hz;
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);

@@ -50,6 +50,11 @@ struct AnalysisReport {
   double energy_max_change = 0.0;  // max |E - E0| over the samples [J]
   // max |E - E0| / |E0|; NaN when E0 = 0 (a run starting at rest with no energy)
   double energy_max_relative_change = 0.0;
+  // What ran when (auto chooses per scene and per phase; the first kMaxRecordedPhases and the last
+  // are kept) and how many phases there were.
+  std::vector<MethodPhase> phases;
+  long phase_count = 0;
+  double max_frequency_hz = 0.0;  // the band integrated (0: every mode) [Hz]
   std::optional<Verification> verification;
   // static (also the equilibrium a modal or buckling analysis is linearized about, or that a
   // transient starts from)

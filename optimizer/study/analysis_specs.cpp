@@ -18,7 +18,7 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
                      IntegratorOptions& io) {
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return;
-  if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk", "modal"}))
+  if (const auto m = r.choice("method", false, {"auto", "bdf", "adams", "dirk", "erk", "modal"}))
     io.method = *m;
   if (const auto t = r.string("table", false)) {
     if (io.method != "dirk" && io.method != "erk")
@@ -53,9 +53,17 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   io.max_step = r.positive("max_step", false).value_or(0.0);
   io.initial_step = r.positive("initial_step", false).value_or(0.0);
   io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
+  if (r.member("max_frequency_hz", false)) {
+    if (const auto f = r.positive("max_frequency_hz", false)) {
+      if (io.method != "modal" && io.method != "auto")
+        r.error("max_frequency_hz", "applies to the \"modal\" and \"auto\" methods");
+      else
+        io.max_frequency_hz = *f;
+    }
+  }
   if (const auto about = r.choice("about", false, {"static", "initial"})) {
-    if (io.method != "modal")
-      r.error("about", "applies to the \"modal\" method");
+    if (io.method != "modal" && io.method != "auto")
+      r.error("about", "applies to the \"modal\" and \"auto\" methods");
     else
       io.about = *about;
   }
@@ -66,15 +74,36 @@ namespace {
 bool read_transient(ObjectReader& r, AnalysisSpec& a) {
   const auto t_end = r.positive("t_end", true);
   const auto step = r.positive("output_step", false);
+  a.transient.integrator.method = "auto";  // the study file's default (docs/study_files.md)
   if (const Json* i = r.member("integrator", false))
     read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
   a.verify = r.boolean("verify", false).value_or(false);
+  // The band integrated: a frequency [Hz], or "output": half the output rate (what the samples
+  // can show). The integrator's own max_frequency_hz, when given, wins.
+  double band = -1.0;  // none; 0: "output"
+  if (const Json* f = r.member("max_frequency_hz", false)) {
+    if (f->is_string()) {
+      if (f->get<std::string>() != "output")
+        r.error("max_frequency_hz", "expected a frequency [Hz] > 0 or \"output\"");
+      else
+        band = 0.0;  // from output_step below
+    } else {
+      band = r.positive("max_frequency_hz", false).value_or(-1.0);
+    }
+    const IntegratorOptions& io = a.transient.integrator;
+    if (band >= 0.0 && io.method != "modal" && io.method != "auto") {
+      r.error("max_frequency_hz", "applies to the \"modal\" and \"auto\" methods");
+      band = -1.0;
+    }
+  }
   a.transient.max_seconds = r.positive("max_seconds", false).value_or(0.0);
   if (const auto initial = r.choice("initial", false, {"scene", "static"}))
     a.initial_static = *initial == "static";
   if (!t_end) return false;
   a.transient.t_end = *t_end;
   a.transient.output_step = step.value_or(*t_end / 100.0);
+  if (band >= 0.0 && !(a.transient.integrator.max_frequency_hz > 0.0))
+    a.transient.integrator.max_frequency_hz = band > 0.0 ? band : 0.5 / a.transient.output_step;
   if (a.transient.output_step > *t_end) {
     r.error("output_step", "must not exceed t_end");
     return false;
@@ -191,8 +220,9 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   const auto name = r.string("name", false);
   const auto load_case = r.string("load_case", false);
   if (!type) {
-    r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "time", "load_steps",
-             "tolerance", "max_iterations", "modes", "about", "solver", "initial"});
+    r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "max_frequency_hz",
+             "time", "load_steps", "tolerance", "max_iterations", "modes", "about", "solver",
+             "initial"});
     return std::nullopt;
   }
   bool ok = true;

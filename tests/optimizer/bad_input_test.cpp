@@ -517,7 +517,8 @@ TEST_F(BadInput, IntegratorOptionsOfAnotherMethod) {
     const char* message;
   } cases[] = {
       {"table", "VERNER_8_5_6", "a Butcher table applies to the \"dirk\" and \"erk\" methods"},
-      {"about", "initial", "applies to the \"modal\" method"},
+      {"about", "initial", "applies to the \"modal\" and \"auto\" methods"},
+      {"max_frequency_hz", 100.0, "applies to the \"modal\" and \"auto\" methods"},
       {"stability_limit_detection", true, "applies to the \"bdf\" method"},
   };
   for (const auto& c : cases) {
@@ -530,6 +531,20 @@ TEST_F(BadInput, IntegratorOptionsOfAnotherMethod) {
     EXPECT_TRUE(
         HasOnlyError(r, std::string("bad.json:/analyses/0/integrator/") + c.key + ":", c.message));
   }
+}
+
+// A transient's band: a frequency > 0 or "output", and only for the methods that have one.
+TEST_F(BadInput, TransientBand) {
+  const std::string at = "bad.json:/analyses/0/max_frequency_hz:";
+  EXPECT_TRUE(HasOnlyError(check(with("/analyses/0/max_frequency_hz", "fast")), at,
+                           "expected a frequency [Hz] > 0 or \"output\""));
+  EXPECT_TRUE(HasOnlyError(check(with("/analyses/0/max_frequency_hz", -5.0)), at, "> 0"));
+  Json study = with("/analyses/0/max_frequency_hz", "output");
+  study["analyses"][0]["integrator"]["method"] = "dirk";
+  EXPECT_TRUE(HasOnlyError(check(study), at, "applies to the \"modal\" and \"auto\" methods"));
+  study["analyses"][0]["integrator"]["method"] = "auto";
+  const Result ok = check(study);
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
 }
 
 // --- Loads and time functions -------------------------------------------------------------------

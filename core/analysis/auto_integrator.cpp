@@ -1,0 +1,243 @@
+#include "core/analysis/auto_integrator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/analysis/modal_integrator.hpp"
+
+namespace beamrail {
+namespace {
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
+}
+
+SolverStats sum(const SolverStats& a, const SolverStats& b) {
+  SolverStats s = a;
+  s.steps += b.steps;
+  s.rhs_evaluations += b.rhs_evaluations;
+  s.jacobian_evaluations += b.jacobian_evaluations;
+  s.nonlinear_iterations += b.nonlinear_iterations;
+  s.nonlinear_failures += b.nonlinear_failures;
+  s.error_test_failures += b.error_test_failures;
+  return s;
+}
+
+// The largest stiffness-proportional damping of the scene's elements [s].
+double largest_damping(const Model& model) {
+  double beta = 0.0;
+  for (const Beam& b : model.beams) beta = std::max(beta, b.damping);
+  for (const Rail& r : model.rails) beta = std::max(beta, r.damping);
+  return beta;
+}
+
+// The quoted name in a message ("body \"tip\" turned ..."), or "".
+std::string quoted(const std::string& text) {
+  const size_t a = text.find('"');
+  const size_t b = a == std::string::npos ? a : text.find('"', a + 1);
+  return b == std::string::npos ? "" : text.substr(a, b - a + 1);
+}
+
+class AutoIntegrator : public Integrator {
+ public:
+  bool init(const IntegratorOptions& o, OdeContext& c, SUNContext sunctx, N_Vector y0,
+            std::string* error) {
+    options_ = o;
+    context_ = &c;
+    sunctx_ = sunctx;
+    const Model& model = c.model;
+    if (model.n_free() == 0)
+      return start_implicit("bdf", "", 0.0, y0, "the scene has no free body", error);
+    if (model.n_dofs > kModalIntegratorMaxDofs && !(o.max_frequency_hz > 0.0))
+      return start_implicit("bdf", "", 0.0, y0,
+                            std::to_string(model.n_free()) +
+                                " free bodies: beyond the modal method's limit of " +
+                                std::to_string(kModalIntegratorMaxDofs / kDofsPerBody),
+                            error);
+    // A small scene's eigenproblem is cheap: relinearize sooner from the start.
+    rotation_limit_ = std::clamp(
+        kAutoRelinearizeRotation * static_cast<double>(model.n_dofs) / kAutoFullRotationDofs,
+        kAutoMinRelinearizeRotation, kAutoRelinearizeRotation);
+    IntegratorOptions m = modal_options();
+    m.about = o.about;
+    std::string why;
+    std::unique_ptr<Integrator> modal = make_modal_integrator(m, c, y0, &why, 0.0);
+    if (!modal) {
+      if (c.timed_out || c.interrupted) {
+        *error = why;
+        return false;
+      }
+      return start_implicit("bdf", "", 0.0, y0, "the modal method could not start: " + why, error);
+    }
+    std::string reason = std::to_string(model.n_free()) + " free bod" +
+                         (model.n_free() == 1 ? "y" : "ies") +
+                         ": small motions about one configuration, each mode's vibration exact";
+    if (const double beta = largest_damping(model); beta > 0.0) {
+      double lowest = 0.0, highest = 0.0;
+      modal_spectrum(*modal, &lowest, &highest);
+      const double step = 2.5 / (beta * highest);
+      const double ratio = 0.5 * beta * std::sqrt(highest);
+      if (ratio > kAutoMaxDampingRatio)
+        return start_implicit("bdf", "", 0.0, y0,
+                              "damping (beta " + number(beta) + " s) damps the fastest mode (" +
+                                  number(std::sqrt(highest)) + " rad/s) at " + number(ratio) +
+                                  " of critical: the modal method's explicit damping would hold "
+                                  "its steps below " +
+                                  number(step) + " s; bdf steps over the decayed modes",
+                              error);
+      reason += "; its damping allows steps up to " + number(step) + " s";
+    }
+    for (const std::string& w : modal->warnings) warnings.push_back(w);
+    const bool about_initial = o.about == "initial" || !modal->warnings.empty();
+    current_ = std::move(modal);
+    modal_ = true;
+    linear_solver = "modal";
+    record(0.0, "modal",
+           reason + (about_initial ? " (linearized about the initial state)"
+                                   : " (linearized about the equilibrium at t = 0)"));
+    return true;
+  }
+
+  int advance(double tout, double tstop, N_Vector y, double* t) override {
+    for (;;) {
+      const int flag = current_->advance(tout, tstop, y, t);
+      if (flag != kModalTooFar || !modal_) return flag;
+      const std::string who = quoted(current_->failure(flag));
+      const long steps = current_->stats().steps;
+      short_runs_ = steps < kAutoMinStepsPerLinearization ? short_runs_ + 1 : 0;
+      before_ = sum(before_, current_->stats());
+      const double turned = rotation_limit_;
+      if (short_runs_ >= 3 && rotation_limit_ < kAutoRelinearizeRotation) {
+        // A fast spin, not a stiff remainder: back to the full limit before giving up, and not
+        // down to this one again.
+        smallest_limit_ = std::min(kAutoRelinearizeRotation, 2.0 * rotation_limit_);
+        rotation_limit_ = kAutoRelinearizeRotation;
+        short_runs_ = 0;
+      } else if (short_runs_ >= 3) {
+        std::string error;
+        if (!start_implicit("dirk", kAutoImplicitTable, *t, y,
+                            "relinearizing every " + std::to_string(steps) + " steps (body " + who +
+                                " turns " + number(rotation_limit_) + " rad that fast)",
+                            &error))
+          return fail(error);
+        continue;
+      }
+      // Relinearizing (a dense eigenproblem, ~n^3) cheap against the phase's steps (~n^2 each):
+      // sooner next time, which lets the remainder the modal method treats explicitly stay
+      // small (a stiff hinge swinging: 98,663 steps for 0.3 s at 0.5 rad, 17,207 at 0.02).
+      const double dofs = static_cast<double>(context_->model.n_dofs);
+      if (short_runs_ == 0 && dofs < kAutoRelinearizeCostRatio * static_cast<double>(steps))
+        rotation_limit_ = std::max(smallest_limit_, 0.5 * rotation_limit_);
+      std::string why;
+      IntegratorOptions m = modal_options();
+      m.about = "initial";
+      m.initial_step = modal_step_size(*current_);  // the motion goes on at its pace
+      std::unique_ptr<Integrator> next = make_modal_integrator(m, *context_, y, &why, *t);
+      if (!next) {
+        if (context_->timed_out || context_->interrupted) return fail(why);
+        std::string error;
+        if (!start_implicit("dirk", kAutoImplicitTable, *t, y,
+                            "the modal method could not relinearize: " + why, &error))
+          return fail(error);
+        continue;
+      }
+      next->restart(*t, y);
+      current_ = std::move(next);
+      record(*t, "modal",
+             "body " + who + " turned " + number(turned) +
+                 " rad from the linearization: relinearized about this state");
+    }
+  }
+
+  void restart(double t, N_Vector y) override { current_->restart(t, y); }
+
+  SolverStats stats() const override { return sum(before_, current_->stats()); }
+
+  std::string failure(int flag) const override {
+    if (flag == kAutoFailed) return failure_;
+    return current_->failure(flag);
+  }
+
+  std::vector<MethodPhase> phases(long* count) const override {
+    *count = count_;
+    std::vector<MethodPhase> out = first_;
+    if (count_ > static_cast<long>(first_.size())) out.push_back(last_);
+    return out;
+  }
+
+ private:
+  static constexpr int kAutoFailed = -1001;
+
+  IntegratorOptions modal_options() const {
+    IntegratorOptions m = options_;
+    m.method = "modal";
+    m.table.clear();
+    m.max_rotation = rotation_limit_;
+    m.max_steps = std::max(1L, options_.max_steps - before_.steps);
+    return m;
+  }
+
+  int fail(const std::string& why) {
+    failure_ = why;
+    return kAutoFailed;
+  }
+
+  // Goes on with an implicit method from (t, y).
+  bool start_implicit(const std::string& method, const std::string& table, double t, N_Vector y,
+                      const std::string& reason, std::string* error) {
+    IntegratorOptions o = options_;
+    o.method = method;
+    o.table = table;
+    o.about.clear();
+    o.max_steps = std::max(1L, options_.max_steps - before_.steps);
+    std::unique_ptr<Integrator> next = make_integrator(o, *context_, sunctx_, y, error);
+    if (!next) return false;
+    if (t > 0.0) next->restart(t, y);
+    for (const std::string& w : next->warnings) warnings.push_back(w);
+    current_ = std::move(next);
+    modal_ = false;
+    linear_solver = current_->linear_solver;
+    nnz = current_->nnz;
+    record(t, table.empty() ? method : method + " " + table, reason);
+    return true;
+  }
+
+  void record(double t, const std::string& method, const std::string& reason) {
+    MethodPhase p{t, method, reason};
+    if (first_.size() + 1 < kMaxRecordedPhases)
+      first_.push_back(std::move(p));
+    else
+      last_ = std::move(p);
+    ++count_;
+  }
+
+  IntegratorOptions options_;
+  OdeContext* context_ = nullptr;
+  SUNContext sunctx_ = nullptr;
+  std::unique_ptr<Integrator> current_;
+  bool modal_ = false;
+  int short_runs_ = 0;  // consecutive linearizations that lasted few steps
+  double rotation_limit_ = kAutoRelinearizeRotation;     // of the current linearization [rad]
+  double smallest_limit_ = kAutoMinRelinearizeRotation;  // the limit halves down to this
+  SolverStats before_;                                   // of the phases before the current one
+  std::string failure_;                                  // why auto itself failed (kAutoFailed)
+  std::vector<MethodPhase> first_;
+  MethodPhase last_;
+  long count_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> make_auto_integrator(const IntegratorOptions& options,
+                                                 OdeContext& context, SUNContext sunctx,
+                                                 N_Vector y0, std::string* error) {
+  auto integrator = std::make_unique<AutoIntegrator>();
+  if (!integrator->init(options, context, sunctx, y0, error)) return nullptr;
+  return integrator;
+}
+
+}  // namespace beamrail

@@ -1,0 +1,290 @@
+// The "auto" method (core/analysis/auto_integrator.hpp), the modal method's error against its
+// tolerance, and band-limited modal runs (max_frequency_hz).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/analysis/auto_integrator.hpp"
+#include "core/analysis/modal_integrator.hpp"
+#include "core/scene/scene_loader.hpp"
+#include "tests/support/reference_cantilever.hpp"
+#include "tests/support/transient_run.hpp"
+#include "tests/support/tumbling_pair.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::options;
+using testing::reference_cantilever;
+using testing::scene_from_json;
+using testing::simulate;
+using testing::TransientRun;
+
+// Largest distance between the runs' free-body centres over the common samples, relative to the
+// largest distance a body moved in the reference (the work-precision study's measure).
+double error_of(const Model& model, const TransientRun& run, const TransientRun& reference) {
+  double error = 0.0, motion = 0.0;
+  for (int b : model.free_bodies) {
+    const Vec3 start = reference.samples.front().c[b];
+    for (const auto& s : reference.samples) motion = std::max(motion, (s.c[b] - start).norm());
+    const size_t n = std::min(run.samples.size(), reference.samples.size());
+    for (size_t k = 0; k < n; ++k)
+      error = std::max(error, (run.samples[k].c[b] - reference.samples[k].c[b]).norm());
+  }
+  return error / motion;
+}
+
+TransientRun tight(const Model& model, double t_end, double output_step, double rtol = 1e-11) {
+  TransientOptions o = options(t_end, output_step, rtol, 1e-2 * rtol);
+  o.integrator.method = "erk";
+  o.integrator.table = "VERNER_8_5_6";
+  return simulate(model, o);
+}
+
+TransientRun run_with(const Model& model, const std::string& method, double t_end,
+                      double output_step, double rtol, double band = 0.0) {
+  TransientOptions o = options(t_end, output_step, rtol, 1e-2 * rtol);
+  o.integrator.method = method;
+  o.integrator.max_frequency_hz = band;
+  return simulate(model, o);
+}
+
+// Issue 17's point-mass tip: 3 kg (rotary inertia 1e-6 kg m^2) on a massless 1 m cantilever of
+// 40 mm square steel under a 1 kN step load: bending at 34 Hz and a 4e5 rad/s rotary mode. bdf
+// took 1.6 million steps (29 s) for 0.3 s at rtol 1e-11; auto takes the modal method, which
+// integrates both modes exactly: one step per output interval.
+const char* kPointMassTip = R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"sq40": {"shape": "rectangle", "width": 0.04, "height": 0.04}},
+    "bodies": [{"name": "tip", "mass": 3.0, "inertia": [1e-6, 1e-6, 1e-6], "position": [1, 0, 0]}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq40"}],
+    "loads": [{"type": "force", "body": "tip", "value": [0, -1000, 0],
+               "time": {"type": "step", "at": 0.0}}]})";
+
+TEST(TransientAuto, PointMassTipTakesTheModalMethod) {
+  const Model model = scene_from_json(kPointMassTip);
+  const TransientRun reference = tight(model, 0.05, 1e-3, 1e-12);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  for (double rtol : {1e-8, 1e-11}) {
+    const TransientRun run = run_with(model, "auto", 0.05, 1e-3, rtol);
+    ASSERT_TRUE(run.result.ok) << run.result.message;
+    const double e = error_of(model, run, reference);
+    std::printf("point-mass tip, auto, rtol %.0e: error %.2e, %ld steps (reference: %ld)\n", rtol,
+                e, run.result.stats.steps, reference.result.stats.steps);
+    ASSERT_EQ(run.result.phases.size(), 1u);
+    EXPECT_EQ(run.result.phases[0].method, "modal");
+    EXPECT_NE(run.result.phases[0].reason.find("1 free body"), std::string::npos)
+        << run.result.phases[0].reason;
+    EXPECT_EQ(run.result.linear_solver, "modal");
+    EXPECT_LE(run.result.stats.steps, 50);  // one per output interval
+    EXPECT_LT(e, 1e-9);                     // the reference's own error is ~1e-11
+  }
+}
+
+// A bob on a stiff hinge (a cylindrical rail: a 50 mm axle of 20 mm steel) swinging +-1.5 rad:
+// auto relinearizes the modal method each time the bob turns 0.02 rad from its linearization (a
+// 6-dof eigenproblem is cheap) and stays within its tolerance of a tight explicit run.
+const char* kStiffHingePendulum = R"({
+    "gravity": [0, 0, -9.81],
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"axle": {"shape": "circle", "diameter": 0.02}},
+    "bodies": [{"name": "bob", "mass": 1.0, "inertia": [0.001, 0.001, 0.001],
+                "position": [0.05, 0, -0.5], "velocity": [0, 3.0, 0],
+                "angular_velocity": [6.0, 0, 0]}],
+    "rails": [{"name": "hinge", "type": "cylindrical", "body1": "ground", "body2": "bob",
+               "point1": [0, 0, 0], "point2": [0.05, 0, 0], "point3": [0, 1, 0],
+               "material": "steel", "section": "axle"}]})";
+
+TEST(TransientAuto, StiffHingePendulumRelinearizes) {
+  Diagnostics diag;
+  const auto json = parse_json(kStiffHingePendulum, "test", diag);
+  const std::optional<Model> model = load_scene(*json, {"test", ""}, diag);
+  ASSERT_TRUE(model) << diag.format();  // (a plausibility warning: the bob hangs 0.5 m off)
+  const double t_end = 0.3;
+  const TransientRun reference = tight(*model, t_end, 1e-2, 1e-11);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  const TransientRun run = run_with(*model, "auto", t_end, 1e-2, 1e-6);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double e = error_of(*model, run, reference);
+  std::printf(
+      "stiff-hinge pendulum, auto, rtol 1e-6, %.1f s: error %.2e, %ld steps, %ld phases "
+      "(reference: %ld steps)\n",
+      t_end, e, run.result.stats.steps, run.result.phase_count, reference.result.stats.steps);
+  for (const MethodPhase& p : run.result.phases)
+    std::printf("  t = %.4f s: %s: %s\n", p.t, p.method.c_str(), p.reason.c_str());
+  ASSERT_GE(run.result.phase_count, 3);  // the bob swings 1.8 rad in 0.3 s
+  EXPECT_EQ(run.result.phases[1].method, "modal");
+  EXPECT_NE(run.result.phases[1].reason.find("body \"bob\" turned 0.02 rad"), std::string::npos)
+      << run.result.phases[1].reason;
+  EXPECT_LT(e, 10 * 1e-6);
+  EXPECT_EQ(run.result.stats.jacobian_evaluations, run.result.phase_count);
+  // Relinearizing sooner as it proves cheap: a fifth of the explicit reference's steps (at 0.5
+  // rad throughout the modal method took 98,663, more than the reference).
+  EXPECT_LT(run.result.stats.steps, reference.result.stats.steps / 5);
+}
+
+// Two bodies on a rod spinning at 40 rad/s: at the small scene's first limit (0.02 rad) auto
+// would relinearize every few steps; it goes back to 0.5 rad instead of leaving the modal method
+// (it used to go on with ESDIRK547: 2.6x the time of bdf, and 7e-4 of the energy lost).
+const char* kFastSpin = R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"rod": {"shape": "circle", "diameter": 0.005}},
+    "bodies": [{"name": "a", "mass": 1.0, "inertia": [0.01, 0.02, 0.03], "position": [0, 0, 0],
+                "angular_velocity": [0.5, 40, 0.3]},
+               {"name": "b", "mass": 1.0, "inertia": [0.01, 0.02, 0.03], "position": [0.5, 0, 0],
+                "angular_velocity": [0.5, 40, 0.3], "velocity": [0, 0, -20]}],
+    "beams": [{"name": "ab", "body1": "a", "body2": "b", "point1": [0.1, 0, 0],
+               "point2": [0.4, 0, 0], "point3": [0.1, 1, 0], "material": "steel",
+               "section": "rod"}]})";
+
+TEST(TransientAuto, FastSpinStaysWithTheModalMethod) {
+  const Model model = scene_from_json(kFastSpin);
+  const double t_end = 0.2, rtol = 1e-6;
+  const TransientRun reference = tight(model, t_end, 1e-2, 1e-11);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  const TransientRun run = run_with(model, "auto", t_end, 1e-2, rtol);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double e = error_of(model, run, reference);
+  const double e0 = run.samples.front().sample.energy();
+  double change = 0.0;
+  for (const auto& s : run.samples) change = std::max(change, std::abs(s.sample.energy() / e0 - 1));
+  std::printf("fast spin, auto, rtol 1e-6: error %.2e, energy change %.2e, %ld steps, %ld phases\n",
+              e, change, run.result.stats.steps, run.result.phase_count);
+  for (const MethodPhase& p : run.result.phases) EXPECT_EQ(p.method, "modal") << p.reason;
+  EXPECT_LT(e, 10 * rtol);
+  EXPECT_LT(change, 10 * rtol);
+}
+
+// The modal method's (and so auto's) error follows rtol: within [1e-3, 10] rtol over rtol
+// 1e-4 .. 1e-9 on the reference cantilever, on the tumbling pair (auto relinearizes once) and
+// on a cantilever whose torsion (5.6e5 rad/s) a step torque sets beating against its bending
+// (where the third-order estimate alone gave up to 290 rtol), against tight explicit runs; the
+// slope of log error over log rtol is printed.
+TEST(TransientAuto, ErrorFollowsTheTolerance) {
+  std::string torsion = reference_cantilever(6);
+  const std::string planar_load = R"("value": [0, -1, 0])";
+  torsion.replace(torsion.find(planar_load), planar_load.size(), R"("value": [0, -1, 0.7])");
+  torsion.replace(torsion.rfind("]}"), 2,
+                  R"(, {"type": "torque", "body": "tip", "value": [0.3, 0, 0],
+                       "time": {"type": "step", "at": 0.0}}]})");
+  struct Case {
+    const char* label;
+    Model model;
+    double t_end;
+  } cases[] = {
+      {"reference cantilever, 10 segments", scene_from_json(reference_cantilever(10)), 0.05},
+      {"tumbling pair", scene_from_json(testing::tumbling_pair_scene()), 0.25},
+      {"cantilever under a step torque", scene_from_json(torsion), 0.02}};
+  for (const Case& c : cases) {
+    const TransientRun reference = tight(c.model, c.t_end, 1e-3, 1e-13);
+    ASSERT_TRUE(reference.result.ok) << reference.result.message;
+    double first = 0.0, last = 0.0;
+    for (double rtol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) {
+      const TransientRun run = run_with(c.model, "auto", c.t_end, 1e-3, rtol);
+      ASSERT_TRUE(run.result.ok) << c.label << ": " << run.result.message;
+      const double e = error_of(c.model, run, reference);
+      std::printf("%s, rtol %.0e: error %.2e = %.3f rtol, %ld steps, %ld phases\n", c.label, rtol,
+                  e, e / rtol, run.result.stats.steps, run.result.phase_count);
+      EXPECT_GT(e, 1e-3 * rtol) << c.label << " rtol " << rtol;
+      EXPECT_LT(e, 10 * rtol) << c.label << " rtol " << rtol;
+      if (first == 0.0) first = e;
+      last = e;
+    }
+    // The observed order of the error in rtol (1: proportional), from the ends of the range.
+    std::printf("%s: error ~ rtol^%.2f\n", c.label, std::log10(first / last) / 5.0);
+  }
+}
+
+// Issue 17's energy question: over a long undamped run the tumbling pair (no loads, no damping:
+// the exact motion keeps its energy) keeps its energy within a few rtol with auto: the error
+// per step follows rtol and does not accumulate as a drift (bdf at rtol 1e-10 lost 2.6e-6 per
+// second, explicit Runge-Kutta 2.7e-8).
+TEST(TransientAuto, LongUndampedRunKeepsItsEnergy) {
+  const Model model = scene_from_json(testing::tumbling_pair_scene());
+  const double t_end = 10.0, rtol = 1e-8;
+  const TransientRun run = run_with(model, "auto", t_end, 0.01, rtol);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double e0 = run.samples.front().sample.energy();
+  double change = 0.0;
+  for (const auto& s : run.samples) change = std::max(change, std::abs(s.sample.energy() / e0 - 1));
+  std::printf(
+      "tumbling pair, auto, rtol %.0e, %.0f s: largest relative energy change %.2e "
+      "(%.2f rtol), %ld steps, %ld phases\n",
+      rtol, t_end, change, change / rtol, run.result.stats.steps, run.result.phase_count);
+  EXPECT_LT(change, 10 * rtol);
+  EXPECT_GT(run.result.phase_count, 10);  // it tumbles: relinearized along the way
+}
+
+// Damping is explicit in the modal method: where it damps the fastest mode beyond 0.1 of
+// critical, auto takes bdf, and says so; light damping keeps the modal method.
+TEST(TransientAuto, HeavyDampingTakesBdf) {
+  // The fastest mode of the cantilever in 4 segments is near 4e4 rad/s: damping ratios 0.04, 0.4.
+  for (double beta : {2e-6, 2e-5}) {
+    std::string json = reference_cantilever(4);
+    const std::string section = R"("section": "sq",)";
+    char damping[64];
+    std::snprintf(damping, sizeof damping, R"( "damping": %.17g,)", beta);
+    json.replace(json.find(section), section.size(), section + damping);
+    const Model model = scene_from_json(json);
+    ASSERT_EQ(model.beams.front().damping, beta);
+    const TransientRun run = run_with(model, "auto", 0.01, 1e-3, 1e-6);
+    ASSERT_TRUE(run.result.ok) << run.result.message;
+    ASSERT_EQ(run.result.phases.size(), 1u);
+    const std::string& reason = run.result.phases[0].reason;
+    std::printf("beta %g: %s: %s\n", beta, run.result.phases[0].method.c_str(), reason.c_str());
+    EXPECT_EQ(run.result.phases[0].method, beta > 1e-5 ? "bdf" : "modal");
+    if (beta > 1e-5) {
+      EXPECT_NE(reason.find(" of critical"), std::string::npos) << reason;
+    }
+  }
+}
+
+TEST(TransientAuto, BeyondTheModalLimitTakesBdf) {
+  const int bodies = kModalIntegratorMaxDofs / kDofsPerBody + 1;
+  const Model model = scene_from_json(reference_cantilever(bodies));
+  const TransientRun run = run_with(model, "auto", 1e-5, 1e-5, 1e-6);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  ASSERT_EQ(run.result.phases.size(), 1u);
+  EXPECT_EQ(run.result.phases[0].method, "bdf");
+  EXPECT_NE(run.result.phases[0].reason.find("201 free bodies: beyond the modal method's limit"),
+            std::string::npos)
+      << run.result.phases[0].reason;
+}
+
+// Band-limited runs (max_frequency_hz) on the reference cantilever in 10 segments against the
+// full model's tight run: the error shrinks as the band widens, and a band above every mode is
+// the full method.
+TEST(TransientBand, ErrorShrinksAsTheBandWidens) {
+  const Model model = scene_from_json(reference_cantilever(10));
+  const TransientRun reference = tight(model, 0.1, 1e-3, 1e-12);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  const TransientRun full = run_with(model, "modal", 0.1, 1e-3, 1e-7);
+  ASSERT_TRUE(full.result.ok) << full.result.message;
+  const double full_error = error_of(model, full, reference);
+  std::printf("full model, rtol 1e-7: error %.2e, %ld steps\n", full_error,
+              full.result.stats.steps);
+  double previous = 1.0;
+  for (double band : {20.0, 100.0, 500.0, 2000.0}) {
+    const TransientRun run = run_with(model, "modal", 0.1, 1e-3, 1e-7, band);
+    ASSERT_TRUE(run.result.ok) << band << " Hz: " << run.result.message;
+    const double e = error_of(model, run, reference);
+    std::printf("band %6.0f Hz, rtol 1e-7: error %.2e against the full model, %ld steps, %ld rhs\n",
+                band, e, run.result.stats.steps, run.result.stats.rhs_evaluations);
+    EXPECT_LT(e, 0.5 * previous) << band;
+    // The modes above the band no longer hold the steps short.
+    EXPECT_LT(run.result.stats.steps, full.result.stats.steps / 2) << band;
+    previous = e;
+  }
+  EXPECT_LT(previous, 1e-4);
+  // Above the highest mode: every mode integrated, the full method.
+  const TransientRun all = run_with(model, "modal", 0.1, 1e-3, 1e-7, 1e9);
+  ASSERT_TRUE(all.result.ok) << all.result.message;
+  EXPECT_EQ(all.result.stats.steps, full.result.stats.steps);
+  EXPECT_LT(error_of(model, all, full), 1e-9);
+}
+
+}  // namespace
+}  // namespace beamrail

@@ -8,14 +8,8 @@
 namespace beamrail {
 namespace {
 
-ElementFrames<double> frames(const ElementEnds& ends, const Data& data, bool twist_free) {
-  return element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], twist_free);
-}
-
-// Largest angle of an element; a cylindrical rail's twist is free, not a deformation.
-double largest_angle(const ElementFrames<double>& f, bool twist_free) {
-  const double bending = std::max(std::abs(f.phi(1)), std::abs(f.phi(2)));
-  return twist_free ? bending : std::max(bending, std::abs(f.phi(0)));
+ElementFrames<double> frames(const ElementEnds& ends, const Data& data, RotationMeasure measure) {
+  return element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], measure);
 }
 
 std::string quoted(const char* kind, const std::string& name) {
@@ -38,19 +32,28 @@ std::string angle_warning(const char* kind, const std::string& name, double angl
 
 }  // namespace
 
-std::string element_out_of_range(const Model& model, const Data& data, double angle_limit) {
-  const auto too_far = [angle_limit](const ElementFrames<double>& f, bool twist_free) {
-    return !(largest_angle(f, twist_free) <= angle_limit);
+std::string element_out_of_range(const Model& model, const Data& data, double fraction) {
+  const auto too_far = [fraction](const ElementFrames<double>& f, RotationMeasure measure) {
+    return !(element_angle(f, measure) <= fraction * angle_limit(measure));
   };
-  const std::string turned = format(
-      " (the range of the element law ends at %.3g rad: its angles are singular at pi/2); "
-      "split it into more segments",
-      kElementAngleLimit);
+  const auto turned = [](RotationMeasure measure) {
+    return measure == RotationMeasure::kRotationVector
+               ? format(
+                     " (the range of the element law ends at %.3g rad: its rotation vector jumps "
+                     "to the opposite axis at pi); split it into more segments",
+                     kRotationVectorLimit)
+               : format(
+                     " (the range of the element law ends at %.3g rad: its angles are singular "
+                     "at pi/2); split it into more segments",
+                     kElementAngleLimit);
+  };
   for (const Beam& e : model.beams) {
-    const ElementFrames<double> f = frames(e.ends, data, false);
-    if (too_far(f, false))
+    const RotationMeasure measure = rotation_measure(e);
+    const ElementFrames<double> f = frames(e.ends, data, measure);
+    if (too_far(f, measure))
       return quoted("beam", e.name) +
-             format(" turned %.3g rad relative to its first end", largest_angle(f, false)) + turned;
+             format(" turned %.3g rad relative to its first end", element_angle(f, measure)) +
+             turned(measure);
     if (!(f.xi(0) > 0.0))
       return quoted("beam", e.name) +
              format(
@@ -59,11 +62,12 @@ std::string element_out_of_range(const Model& model, const Data& data, double an
                  f.xi(0), e.ends.length);
   }
   for (const Rail& e : model.rails) {
-    const bool twist_free = e.type == RailType::kCylindrical;
-    const ElementFrames<double> f = frames(e.ends, data, twist_free);
-    if (too_far(f, twist_free))
+    const RotationMeasure measure = rotation_measure(e);
+    const ElementFrames<double> f = frames(e.ends, data, measure);
+    if (too_far(f, measure))
       return quoted("rail", e.name) +
-             format(" turned %.3g rad relative to the rail", largest_angle(f, twist_free)) + turned;
+             format(" turned %.3g rad relative to the rail", element_angle(f, measure)) +
+             turned(measure);
     if (!(f.xi(0) >= e.travel_min && f.xi(0) <= e.travel_max))
       return quoted("rail", e.name) +
              format(
@@ -89,11 +93,12 @@ std::string element_turned_beyond(const Model& model, const Data& data, double l
                angle, limit);
   };
   for (const Beam& e : model.beams)
-    if (const double r = rotation(frames(e.ends, data, false), false); !(r <= limit))
+    if (const double r = rotation(frames(e.ends, data, rotation_measure(e)), false); !(r <= limit))
       return describe("beam", e.name, r);
   for (const Rail& e : model.rails) {
     const bool twist_free = e.type == RailType::kCylindrical;
-    if (const double r = rotation(frames(e.ends, data, twist_free), twist_free); !(r <= limit))
+    if (const double r = rotation(frames(e.ends, data, rotation_measure(e)), twist_free);
+        !(r <= limit))
       return describe("rail", e.name, r);
   }
   return "";
@@ -106,13 +111,15 @@ void DeformationCheck::observe(const Model& model, const Data& data, double t) {
   const auto record = [t](Peak& peak, double value) {
     if (value > peak.value) peak = {value, t};
   };
-  for (size_t i = 0; i < model.beams.size(); ++i)
-    record(beams_[i], largest_angle(frames(model.beams[i].ends, data, false), false));
+  for (size_t i = 0; i < model.beams.size(); ++i) {
+    const RotationMeasure measure = rotation_measure(model.beams[i]);
+    record(beams_[i], element_angle(frames(model.beams[i].ends, data, measure), measure));
+  }
   for (size_t i = 0; i < model.rails.size(); ++i) {
     const Rail& e = model.rails[i];
-    const bool twist_free = e.type == RailType::kCylindrical;
-    const ElementFrames<double> f = frames(e.ends, data, twist_free);
-    record(rails_[i], largest_angle(f, twist_free));
+    const RotationMeasure measure = rotation_measure(e);
+    const ElementFrames<double> f = frames(e.ends, data, measure);
+    record(rails_[i], element_angle(f, measure));
     record(travel_[i], std::abs(f.xi(0)) / e.ends.length);
   }
 }

@@ -16,9 +16,10 @@ ElementDeformation::ElementDeformation(const Model& model, const Data& data) {
     hi = hi.cwiseMax(p);
   };
   for (int i : model.free_bodies) extend(centre(model, data, i));
-  const auto add = [&](const ElementEnds& ends, bool rail, bool twist_free) {
+  const auto add = [&](const ElementEnds& ends, bool rail, RotationMeasure measure) {
     const ElementFrames<double> f =
-        element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], twist_free);
+        element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], measure);
+    const bool twist_free = measure == RotationMeasure::kAnglesTwistFree;
     const Vec3 c1 = centre(model, data, ends.body1);
     extend(c1 + f.R1);
     extend(c1 + f.lever1);
@@ -30,8 +31,8 @@ ElementDeformation::ElementDeformation(const Model& model, const Data& data) {
     row.counts = {!rail, true, true, !twist_free, true, true};
     rows_.push_back(row);
   };
-  for (const Beam& e : model.beams) add(e.ends, false, false);
-  for (const Rail& e : model.rails) add(e.ends, true, e.type == RailType::kCylindrical);
+  for (const Beam& e : model.beams) add(e.ends, false, rotation_measure(e));
+  for (const Rail& e : model.rails) add(e.ends, true, rotation_measure(e));
   const double extent = model.n_free() > 0 ? (hi - lo).norm() : 0.0;
   length_ = extent > 0.0 && std::isfinite(extent) ? extent : 1.0;
 }

@@ -261,7 +261,7 @@ struct Newton {
     std::vector<double> out;
     for (const Rail& e : model.rails)
       out.push_back(element_frames(e.ends, data.pose[e.ends.body1], data.pose[e.ends.body2],
-                                   e.type == RailType::kCylindrical)
+                                   rotation_measure(e))
                         .xi(0));
     return out;
   }
@@ -527,8 +527,7 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
                          std::to_string(result.load_steps) +
                          (result.load_steps == 1 ? " load step)" : " load steps)");
         // An element near the end of its law's range explains most such failures.
-        if (std::string edge = element_out_of_range(model, data, 0.8 * kElementAngleLimit);
-            !edge.empty())
+        if (std::string edge = element_out_of_range(model, data, 0.8); !edge.empty())
           result.message = format("at load factor %.6g, ", done) + edge +
                            "; beyond it the Newton iterations failed: " + result.message;
         result.timed_out = budget.passed();

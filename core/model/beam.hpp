@@ -27,11 +27,12 @@ LocalForces<S> beam_law(const Beam& beam, const Vec6T<S>& s) {
   return out;
 }
 
-// Whether a beam's configuration lies outside the range of its law: an angle beyond
-// kElementAngleLimit, or point 2 at or behind point 1 along the axis (compressed through zero
-// length: inverted).
-inline bool beam_out_of_range(const ElementFrames<double>& f) {
-  return !(f.xi(0) > 0.0) || !(f.phi.cwiseAbs().maxCoeff() <= kElementAngleLimit);
+// Whether a beam's configuration lies outside the range of its law: an angle beyond the limit of
+// its rotation measure (angle_limit), or point 2 at or behind point 1 along the axis (compressed
+// through zero length: inverted).
+inline bool beam_out_of_range(const Beam& beam, const ElementFrames<double>& f) {
+  const RotationMeasure measure = rotation_measure(beam);
+  return !(f.xi(0) > 0.0) || !(element_angle(f, measure) <= angle_limit(measure));
 }
 
 // Adds the beam's wrenches (force, moment about the centre of mass; global) on body 1 and body 2
@@ -40,9 +41,9 @@ inline bool beam_out_of_range(const ElementFrames<double>& f) {
 template <class T>
 T beam_wrenches(const Beam& beam, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
                 bool* out_of_range = nullptr) {
-  const ElementFrames<T> f = element_frames(beam.ends, b1, b2);
+  const ElementFrames<T> f = element_frames(beam.ends, b1, b2, rotation_measure(beam));
   if constexpr (std::is_same_v<T, double>)
-    if (out_of_range && beam_out_of_range(f)) *out_of_range = true;
+    if (out_of_range && beam_out_of_range(beam, f)) *out_of_range = true;
   Vec6T<T> s;
   s << f.xi, f.phi;
   const LocalForces<T> law = beam_law(beam, s);

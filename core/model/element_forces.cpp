@@ -28,7 +28,7 @@ EndForces beam_end_forces(const Model& model, const Data& data, int index) {
   const Pose<double> b1 = at_rest(data.pose[e.ends.body1]), b2 = at_rest(data.pose[e.ends.body2]);
   Vec6 w1 = Vec6::Zero(), w2 = Vec6::Zero();
   beam_wrenches(e, b1, b2, w1, w2);
-  return to_end_forces(element_frames(e.ends, b1, b2), w1, w2);
+  return to_end_forces(element_frames(e.ends, b1, b2, rotation_measure(e)), w1, w2);
 }
 
 EndForces rail_end_forces(const Model& model, const Data& data, int index) {
@@ -37,7 +37,7 @@ EndForces rail_end_forces(const Model& model, const Data& data, int index) {
   Vec6 w1 = Vec6::Zero(), w2 = Vec6::Zero();
   bool floored = false;
   rail_wrenches(e, b1, b2, w1, w2, &floored);
-  return to_end_forces(element_frames(e.ends, b1, b2, e.type == RailType::kCylindrical), w1, w2);
+  return to_end_forces(element_frames(e.ends, b1, b2, rotation_measure(e)), w1, w2);
 }
 
 double end_stress(const SectionProperties& s, const EndForces& forces) {

@@ -88,9 +88,10 @@ inline Eigen::Matrix<double, 6, 12> kinematic_map(const ElementFrames<double>& f
 //   E turns with body 1 (dE g = -[E g]x dtheta1), the levers move with the bodies, and T changes
 //   with the relative rotation (its derivative by forward AD over the three rotation directions).
 // law(s) evaluates the element's LocalForces on Vec6T<Ad6> coordinates.
+// measure: the element's rotation measure (the one f was computed with).
 template <class Law>
 Mat12 configuration_jacobian(const ElementFrames<double>& f, Formulation formulation,
-                             bool twist_free, Law&& law) {
+                             RotationMeasure measure, Law&& law) {
   const Mat3& e = f.E1;
   const Mat3 et = e.transpose();
   const Eigen::Matrix<double, 6, 12> j = kinematic_map(f);
@@ -124,7 +125,7 @@ Mat12 configuration_jacobian(const ElementFrames<double>& f, Formulation formula
     const Mat3T<Ad3> rotated = f.a.cast<Ad3>() + skew<Ad3>(w) * f.a;
     Vec3T<Ad3> phi;
     Mat3T<Ad3> t;
-    relative_angles(rotated, twist_free, phi, t);
+    relative_rotation(rotated, measure, phi, t);
     const Vec3T<Ad3> tg = t.transpose() * g.tail<3>();
     Mat3 gm;
     for (int r = 0; r < 3; ++r)

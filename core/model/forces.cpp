@@ -87,7 +87,8 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
     const auto& blocks = model.pattern.beam_blocks[n];
     if (e.damping == 0.0 || !with_velocity) {
       scatter(blocks,
-              configuration_jacobian(element_frames(e.ends, p1, p2), e.formulation, false,
+              configuration_jacobian(element_frames(e.ends, p1, p2, rotation_measure(e)),
+                                     e.formulation, rotation_measure(e),
                                      [&e](const Vec6T<Ad6>& s) { return beam_law(e, s); }),
               data.stiffness);
       continue;
@@ -105,11 +106,10 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
     const Pose<double>& p1 = data.pose[e.ends.body1];
     const Pose<double>& p2 = data.pose[e.ends.body2];
     const auto& blocks = model.pattern.rail_blocks[n];
-    const bool twist_free = e.type == RailType::kCylindrical;
     if (e.damping == 0.0 || !with_velocity) {
       scatter(blocks,
-              configuration_jacobian(element_frames(e.ends, p1, p2, twist_free), e.formulation,
-                                     twist_free,
+              configuration_jacobian(element_frames(e.ends, p1, p2, rotation_measure(e)),
+                                     e.formulation, rotation_measure(e),
                                      [&e](const Vec6T<Ad6>& s) {
                                        bool floored = false;
                                        return rail_law(e, s, &floored);

@@ -74,8 +74,7 @@ LocalForces<S> rail_law(const Rail& rail, const Vec6T<S>& s, bool* floored) {
 
 // The largest angle of a rail that counts as deformation (a cylindrical rail's twist is free).
 inline double rail_angle(const Rail& rail, const ElementFrames<double>& f) {
-  const double bending = std::max(std::abs(f.phi(1)), std::abs(f.phi(2)));
-  return rail.type == RailType::kCylindrical ? bending : std::max(bending, std::abs(f.phi(0)));
+  return element_angle(f, rotation_measure(rail));
 }
 
 // Whether a rail's configuration lies outside the range of its law: an angle beyond
@@ -91,7 +90,7 @@ inline bool rail_out_of_range(const Rail& rail, const ElementFrames<double>& f) 
 template <class T>
 T rail_wrenches(const Rail& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
                 bool* floored, bool* out_of_range = nullptr) {
-  const ElementFrames<T> f = element_frames(rail.ends, b1, b2, rail.type == RailType::kCylindrical);
+  const ElementFrames<T> f = element_frames(rail.ends, b1, b2, rotation_measure(rail));
   if constexpr (std::is_same_v<T, double>)
     if (out_of_range && rail_out_of_range(rail, f)) *out_of_range = true;
   Vec6T<T> s;

@@ -306,12 +306,13 @@ class SceneDrawing {
     for (size_t i = 0; i < model.beams.size(); ++i) {
       curve(false, static_cast<int>(i), model.beams[i].ends,
             model.beams[i].segment > 0 ? kSegmentCurvePoints : kCurvePoints);
+      curves_.back().measure = rotation_measure(model.beams[i]);
       element_names.push_back(model.beams[i].name);
     }
     for (size_t i = 0; i < model.rails.size(); ++i) {
       const Rail& r = model.rails[i];
       curve(true, static_cast<int>(i), r.ends, kCurvePoints);
-      curves_.back().twist_free = r.type == RailType::kCylindrical;
+      curves_.back().measure = rotation_measure(r);
       curves_.back().lower = r.travel_min, curves_.back().upper = r.travel_max;
       element_names.push_back(r.name);
     }
@@ -436,7 +437,8 @@ class SceneDrawing {
     std::vector<Vec3> levers;     // attachment points, body axes, from the centre
   };
   struct Curve {
-    bool rail = false, twist_free = false;
+    bool rail = false;
+    RotationMeasure measure = RotationMeasure::kAngles;  // the element's (slopes from phi)
     int index = 0;
     const ElementEnds* ends = nullptr;
     std::vector<double> s;                                    // fractions of the deformable length
@@ -476,7 +478,7 @@ class SceneDrawing {
   void draw(const Curve& c, const Data& data, Vec3* out) const {
     const ElementEnds& e = *c.ends;
     const Pose<double>& b1 = data.pose[e.body1];
-    const ElementFrames<double> f = element_frames(e, b1, data.pose[e.body2], c.twist_free);
+    const ElementFrames<double> f = element_frames(e, b1, data.pose[e.body2], c.measure);
     const Vec3 p1 = centre(model_, data, e.body1) + f.R1;
     const double l = f.xi(0);
     const double slope_y = f.phi(2), slope_z = -f.phi(1);

@@ -82,8 +82,9 @@ TEST(Conservation, TumblingPairConservesEnergyAndMomenta) {
       energy_drift = std::max(energy_drift, std::abs(s.sample.energy() / e0 - 1));
       com_error = std::max(com_error, (m.com - (m0.com + s.sample.t * m0.v_com)).norm());
       h_drift = std::max(h_drift, (m.h - m0.h).norm() / m0.h.norm());
-      const ElementFrames<double> f = element_frames(model.beams[0].ends, s.pose[1], s.pose[2]);
-      max_phi = std::max(max_phi, f.phi.cwiseAbs().maxCoeff());
+      const ElementFrames<double> f = element_frames(model.beams[0].ends, s.pose[1], s.pose[2],
+                                                     rotation_measure(model.beams[0]));
+      max_phi = std::max(max_phi, element_angle(f, rotation_measure(model.beams[0])));
     }
     const double final_energy = run.samples.back().sample.energy() / e0 - 1;
     std::printf(

@@ -116,8 +116,12 @@ TEST(NonConservativeLoads, TipTorqueModesAreThoseOfTheNonSymmetricProblem) {
 // A clamped beam bent into a circle by a tip torque of 2 EI / L (the tip turned 2 rad) is a
 // stable equilibrium: the static analysis reports it ok with the exact tip rotation, the modal
 // analysis finds real positive eigenvalues, and a transient that ramps the torque on under a
-// constant 0.01 N out-of-plane force stays within twice the static out-of-plane deflection. (Its
-// symmetric part has a negative eigenvalue: that test called it unstable.)
+// constant 0.01 N out-of-plane force does not grow once the torque is on: its largest
+// out-of-plane deflection over the last 2 s is within 10 % of that over the 2 s before. (Its symmetric
+// part has a negative eigenvalue: that test called it unstable.) The circle's static out-of-plane
+// deflection converges at second order (10 to 160 segments: 1.2358e-5 to 1.2440e-5 m), to where
+// the paper law converges at first order; with the atan2 angles the energy law gave 2.3e-5 m at
+// 10 segments, and the transient stayed within twice that.
 TEST(NonConservativeLoads, BeamBentIntoACircleByATipTorqueIsStable) {
   const double ei = kE * std::pow(0.01, 4) / 12;
   Scene s = bent_cantilever(2 * ei, 10);
@@ -144,11 +148,18 @@ TEST(NonConservativeLoads, BeamBentIntoACircleByATipTorqueIsStable) {
   const Model moving = ramped.model();
   const testing::TransientRun run = testing::simulate(moving, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;
-  double peak = 0.0;
-  for (const auto& sample : run.samples) peak = std::max(peak, std::abs(sample.c[tip].z()));
-  std::printf("transient: largest out-of-plane deflection %.4e m (%.2f x static)\n", peak,
-              peak / std::abs(z_static));
-  EXPECT_LT(peak, 2.0 * std::abs(z_static));
+  double before = 0.0, last = 0.0;  // largest |z| over 4-6 s and 6-8 s (the torque is on at 4 s)
+  for (const auto& sample : run.samples) {
+    const double z = std::abs(sample.c[tip].z());
+    if (sample.sample.t >= 4.0 && sample.sample.t < 6.0) before = std::max(before, z);
+    if (sample.sample.t >= 6.0) last = std::max(last, z);
+  }
+  std::printf(
+      "transient: largest out-of-plane deflection %.4e m over 4-6 s, %.4e m over 6-8 s (static "
+      "%.4e m)\n",
+      before, last, std::abs(z_static));
+  // Bounded: a flutter growing by more than 0.05 per second would pass this in 2 s.
+  EXPECT_LT(last, 1.1 * before);
 }
 
 // The stability test of a non-symmetric tangent, densely (10 segments, 60 degrees of freedom)
@@ -185,10 +196,14 @@ TEST(NonConservativeLoads, StabilityOfANonSymmetricTangentDenseAndNearZero) {
   }
 }
 
-// The flutter is real: the growth rate of the shaft's vibration from the eigenvalues of
-// K x = lambda M x (s = sqrt(-lambda)) is the one a transient measures, 0.38 per second
-// (10 segments, 20 N m). A single massless beam with the same torque has two real eigenvalues and
-// stays bounded.
+// The flutter is real: the growth rate of the shaft's fundamental bending pair from the
+// eigenvalues of K x = lambda M x (s = sqrt(-lambda)) is the one a transient measures from its
+// tip, 0.44 per second (10 segments, 20 N m, the torque ramped on over 0.5 s). With equal bending
+// stiffnesses every bending pair flutters (in Ziegler's continuum the growth rises with the
+// wavenumber); the faster growing higher pairs leave 10 % in the tip's envelope by 8 s. A single
+// massless beam with the same torque flutters too. (With the atan2 angles, whose phi_y picks up
+// tan(twist) phi_z, the twisted element was stiffer in one bending plane than the other: only the
+// fundamental pair fluttered, at 0.38 per second, and the single beam stayed bounded.)
 TEST(NonConservativeLoads, FlutterGrowthRateIsTheTransients) {
   Scene s = bent_cantilever(0.0, 10);
   s.j["loads"] = Json::array();
@@ -201,11 +216,13 @@ TEST(NonConservativeLoads, FlutterGrowthRateIsTheTransients) {
   Eigen::VectorXcd values;
   ASSERT_TRUE(solve_dense_nonsymmetric(-Eigen::MatrixXd(stiffness_matrix(model, data)),
                                        Eigen::MatrixXd(mass_matrix(model, data)), values));
-  double predicted = 0.0;
+  double predicted = 0.0, lowest = INFINITY;  // the growth of the lowest-frequency pair
   for (Eigen::Index i = 0; i < values.size(); ++i)
-    predicted = std::max(predicted, std::abs(std::sqrt(-values(i)).real()));
+    if (const std::complex<double> root = std::sqrt(-values(i)); std::abs(root.imag()) < lowest)
+      lowest = std::abs(root.imag()), predicted = std::abs(root.real());
 
   s.last_body()["velocity"] = testing::vec(0, 1e-3, 0);
+  s.j["loads"][0]["time"] = {{"type", "ramp"}, {"from", 0}, {"to", 0.5}};
   TransientOptions o = testing::options(8.0, 2e-3, 1e-6, 1e-9);
   o.integrator.method = "dirk";
   const Model moving = s.model();
@@ -230,8 +247,9 @@ TEST(NonConservativeLoads, FlutterGrowthRateIsTheTransients) {
   single.torque("tip", Vec3(20, 0, 0));
   const Model one = single.model();
   Data one_data(one);
-  const StaticResult stable = solve_static(one, StaticOptions{}, one_data);
-  EXPECT_TRUE(stable.ok) << stable.message;
+  const StaticResult single_result = solve_static(one, StaticOptions{}, one_data);
+  EXPECT_FALSE(single_result.ok);
+  EXPECT_GT(single_result.flutter_pairs, 0) << single_result.message;
 }
 
 }  // namespace

@@ -74,7 +74,8 @@ TEST(Beam, ForcesBalanceAndMomentsBalanceLocally) {
       ASSERT_GT(scale, 0.0);
       worst_force = std::max(worst_force, (f1 + f2).norm() / scale);
       // End moments about the attachment points, in the left-end frame.
-      const ElementFrames<double> fr = element_frames(s.beam.ends, s.b1, s.b2);
+      const ElementFrames<double> fr =
+          element_frames(s.beam.ends, s.b1, s.b2, rotation_measure(s.beam));
       const Vec3 m1 = fr.E1.transpose() * (w.w1.tail<3>() - fr.R1.cross(f1));
       const Vec3 m2 = fr.E1.transpose() * (w.w2.tail<3>() - fr.R2.cross(f2));
       const Vec3 f2_local = fr.E1.transpose() * f2;
@@ -130,6 +131,44 @@ TEST(Beam, RigidMotionOfBothBodiesGivesNoForce) {
   }
 }
 
+// Deformed up to 2.5 rad and moved rigidly by a large rotation and shift: the energy is the same
+// and the wrenches turn with the bodies (moments about the centres), for both laws; the rotation
+// vector of the energy law (|phi| up to 2.5) and the paper's angles (up to 1.3 rad) alike.
+TEST(Beam, LawsAreInvariantUnderARigidMotionOfBothBodies) {
+  for (Formulation f : kBoth) {
+    Random rng(19);
+    double worst_energy = 0, worst_wrench = 0, largest = 0;
+    for (int i = 0; i < 200; ++i) {
+      BeamCase s = random_case(rng, f);
+      const double size = f == Formulation::kEnergy ? 2.5 : 0.75;  // the angles: below 1.5 rad
+      s.b2 = testing::perturbed(s.b2, rng.vec3(0.05 * s.beam.ends.length),
+                                rng.uniform(0.0, size) * rng.vec3(1.0).normalized());
+      const RotationMeasure m = rotation_measure(s.beam);
+      const double angle = element_angle(element_frames(s.beam.ends, s.b1, s.b2, m), m);
+      largest = std::max(largest, angle);
+      const Wrenches w = evaluate(s.beam, s.b1, s.b2);
+      const Mat3 rot = rng.rotation();
+      const Vec3 shift = rng.vec3(5.0);
+      const Wrenches moved =
+          evaluate(s.beam, testing::moved(s.b1, rot, shift), testing::moved(s.b2, rot, shift));
+      worst_energy = std::max(worst_energy, std::abs(moved.energy / w.energy - 1));
+      Eigen::Matrix<double, 12, 1> turned, expected;
+      turned << moved.w1, moved.w2;
+      expected << rot * w.w1.head<3>(), rot * w.w1.tail<3>(), rot * w.w2.head<3>(),
+          rot * w.w2.tail<3>();
+      worst_wrench = std::max(worst_wrench, (turned - expected).norm() / expected.norm());
+    }
+    std::printf("%s: rigid motion, angles up to %.2f rad: worst energy change %.2e, wrench %.2e\n",
+                name(f), largest, worst_energy, worst_wrench);
+    EXPECT_GT(largest, f == Formulation::kEnergy ? 2.0 : 0.5);
+    // Rounding: the moved poses (shifts up to 5 m, rotations) carry eps of their size, which the
+    // chord's cancellation (l ~ 2 m against deformations of a few percent) and the axial
+    // stiffness enlarge to ~1e-12 of the energy; a measure that is not invariant errs by O(1).
+    EXPECT_LT(worst_energy, 1e-10) << name(f);
+    EXPECT_LT(worst_wrench, 1e-10) << name(f);
+  }
+}
+
 // Local end vectors at small deformation equal K1 delta and K2 delta (delta as the kernel measures
 // it, steps 3-4), and that delta equals the deformation imposed by moving body 2 (body 1 held).
 TEST(Beam, ForcesEqualStiffnessTimesDeformationWhenSmall) {
@@ -138,14 +177,16 @@ TEST(Beam, ForcesEqualStiffnessTimesDeformationWhenSmall) {
     double worst = 0, worst_delta = 0;
     for (int i = 0; i < 200; ++i) {
       BeamCase s = random_case(rng, f);
-      const ElementFrames<double> fr0 = element_frames(s.beam.ends, s.b1, s.b2);
+      const ElementFrames<double> fr0 =
+          element_frames(s.beam.ends, s.b1, s.b2, rotation_measure(s.beam));
       const Vec3 dc = rng.vec3(1e-8 * s.beam.ends.length), theta = rng.vec3(1e-8);
       const Pose<double> b2 = testing::perturbed(s.b2, dc, theta);
       const Wrenches w = evaluate(s.beam, s.b1, b2);
       Vec6 imposed;
       imposed.head<3>() = fr0.E1.transpose() * (dc + theta.cross(fr0.R2));
       imposed.tail<3>() = fr0.E1.transpose() * theta;
-      const ElementFrames<double> fr = element_frames(s.beam.ends, s.b1, b2);
+      const ElementFrames<double> fr =
+          element_frames(s.beam.ends, s.b1, b2, rotation_measure(s.beam));
       const Vec6 delta = beam_deformation(s.beam, fr);
       worst_delta = std::max(worst_delta, (delta - imposed).norm() / imposed.norm());
       const StiffnessBlocks<double> k(s.beam.ea, s.beam.gj, s.beam.eiy, s.beam.eiz,
@@ -222,6 +263,37 @@ TEST(Beam, AutomaticDifferentiationJacobianMatchesCentralDifferences) {
     EXPECT_LT(worst_x, 1e-6) << name(f);
     EXPECT_LT(worst_v, 1e-6) << name(f);
   }
+}
+
+// The energy law's rotation vector at large relative rotations (0.5 to 2.9 rad) and exactly at
+// the undeformed state (A = I exactly: both bodies unrotated, the element along x): AD against
+// central differences of the wrenches.
+TEST(Beam, EnergyLawJacobianMatchesCentralDifferencesAtLargeRotationsAndAtRest) {
+  Random rng(18);
+  double worst = 0;
+  for (int i = 0; i < 100; ++i) {
+    BeamCase s = random_case(rng, Formulation::kEnergy);
+    if (i == 0) {  // at rest, A = I exactly
+      s.b1 = testing::pose(Vec3::Zero(), Mat3::Identity());
+      s.b2 = testing::pose(Vec3(2, 0, 0), Mat3::Identity());
+      s.beam.ends = testing::make_ends(Vec3::Zero(), Vec3(2, 0, 0), Vec3(0, 1, 0), s.b1, s.b2);
+    } else {
+      s.b2 = testing::perturbed(s.b2, rng.vec3(0.05 * s.beam.ends.length),
+                                rng.uniform(0.5, 2.9) * rng.vec3(1.0).normalized());
+    }
+    const auto kernel = [&s](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
+                             Vec6T<Ad12>& w2) { beam_wrenches(s.beam, b1, b2, w1, w2); };
+    const Mat12 ad =
+        element_jacobian(seed_configuration(s.b1, 0), seed_configuration(s.b2, 6), kernel);
+    const Mat12 fd = fd_configuration(s.beam, s.b1, s.b2, 1e-6);
+    ASSERT_TRUE(ad.allFinite()) << "case " << i;
+    const double difference = (ad - fd).cwiseAbs().maxCoeff() / ad.cwiseAbs().maxCoeff();
+    if (i == 0) std::printf("energy, at rest: AD vs central FD %.2e\n", difference);
+    worst = std::max(worst, difference);
+  }
+  std::printf("energy, rotations 0.5-2.9 rad: AD vs central FD, worst relative difference %.2e\n",
+              worst);
+  EXPECT_LT(worst, 1e-6);
 }
 
 TEST(Beam, EnergyFormulationWrenchesAreTheNegativeEnergyGradient) {

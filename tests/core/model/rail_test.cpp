@@ -65,7 +65,7 @@ RailCase random_case(Random& rng, RailType type, Formulation formulation, double
 
 // The frames as the kernel measures them (cylindrical rails: twist-free bending angles).
 ElementFrames<double> frames(const Rail& rail, const Pose<double>& b1, const Pose<double>& b2) {
-  return element_frames(rail.ends, b1, b2, rail.type == RailType::kCylindrical);
+  return element_frames(rail.ends, b1, b2, rotation_measure(rail));
 }
 ElementFrames<double> frames(const RailCase& s) { return frames(s.rail, s.b1, s.b2); }
 

@@ -20,6 +20,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
+// Load steps in a row, each half the last, that may find "no equilibrium" before the analysis
+// gives up with it.
+constexpr int kNoEquilibriumRetries = 4;
 
 std::string format(const char* pattern, double a, double b = 0.0) {
   char text[400];
@@ -65,6 +68,24 @@ Eigen::VectorXd displacement(const Model& model, const Data& data) {
     x.segment<3>(kDofsPerBody * k + 3) = data.rotation[i];
   }
   return x;
+}
+
+// The smallest ratio of KLU's pivots (rcond) that is still a stiffness rather than a direction
+// without one. 1e-8 for a compact structure. A chain of n elements in series has physical pivot
+// ratios down to about 1 / (4 n^3) (the stiffness of an n-segment cantilever at its tip against
+// that of one segment: a 512-chord bend has 2e-9), so a structure whose every body is held by
+// beams (no mechanism is possible) accepts pivots down to 1e-8 / n^3, with n its total element
+// length over its shortest element, but not below 1e-14, where rounding begins; a structure that
+// is not held may be a mechanism (a free carriage: 1e-10), and keeps 1e-8.
+double pivot_floor(const Model& model) {
+  if (!held_by_beams(model)) return 1e-8;
+  double total = 0.0, shortest = INFINITY;
+  for (const Beam& e : model.beams) {
+    total += e.ends.length;
+    shortest = std::min(shortest, e.ends.length);
+  }
+  const double n = shortest > 0.0 && std::isfinite(total / shortest) ? total / shortest : 1.0;
+  return std::max(1e-8 / std::pow(std::max(n, 1.0), 3), 1e-14);
 }
 
 // A factorized tangent. KLU factors it with the symbolic analysis of the topology's velocity-level
@@ -126,7 +147,8 @@ class TangentSolver {
         // a residual small against |b|: a numerically singular matrix factorizes but solves
         // badly (a free carriage: pivot ratio ~1e-10).
         const double s_norm = abs_times(Eigen::VectorXd::Ones(s.cols())).maxCoeff();
-        if (common_.rcond > 1e-8 &&
+        if (floor_ < 0.0) floor_ = pivot_floor(model);
+        if (common_.rcond > floor_ &&
             r.lpNorm<Eigen::Infinity>() <= 1e-12 * (s_norm * x.lpNorm<Eigen::Infinity>() + 1.0))
           return true;
         if (r.norm() <= 1e-8 * probe.norm()) return true;
@@ -204,6 +226,7 @@ class TangentSolver {
   }
   Eigen::VectorXd scale_;      // D of the dense decomposition
   double fresh_growth_ = 1.0;  // reciprocal pivot growth of the last factorization with pivoting
+  double floor_ = -1.0;        // pivot_floor of the model (computed at the first factorization)
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
   bool use_dense_ = false;
 };
@@ -231,7 +254,8 @@ struct Newton {
   double floor = 0.0;       // rounding floor at the last tangent
   double correction = 0.0;  // last correction / displacement
   std::string failure;
-  bool final = false;  // no smaller load step can help (no equilibrium, precision, budget)
+  bool final = false;      // no smaller load step can help (no equilibrium, precision, budget)
+  int no_equilibrium = 0;  // load steps in a row that found no equilibrium
 
   struct Saved {
     std::vector<Pose<double>> pose;
@@ -335,10 +359,14 @@ struct Newton {
               "buckles or snaps through, or an element reaches the end of its law's "
               "range)",
               false);
+        // A smaller load step is tried (kNoEquilibriumRetries times in a row at most): an
+        // iterate far from the path may meet a direction without stiffness that the
+        // equilibrium does not have.
+        ++no_equilibrium;
         return fail(
             "the loads push along a direction without stiffness (a free mechanism, such as a "
             "carriage pushed along its rails): there is no equilibrium",
-            true);
+            no_equilibrium > kNoEquilibriumRetries);
       }
       const Eigen::VectorXd x = displacement(model, data);
       floor = solver.rounding_floor(x, length);
@@ -515,6 +543,7 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
       newton.failure.clear();
       if (newton.solve(factor, factor * options.tolerance * f_ref)) {
         done = factor;
+        newton.no_equilibrium = 0;
         if (options.load_steps == 0) increment = std::min(1.0, 2.0 * increment);
         continue;
       }

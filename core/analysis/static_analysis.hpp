@@ -2,7 +2,10 @@
 // loads at a given time, geometrically nonlinear. Newton's method on 6 unknowns per free body
 // (centre displacement and rotation increment) with the exact tangent by automatic differentiation
 // (factored by KLU with the topology's shared symbolic analysis), full Newton steps (halved only
-// when they make the forces non-finite), and automatic load stepping when a full load step fails.
+// when they make the forces non-finite), and automatic load stepping when a full load step fails
+// (also when it found no equilibrium: up to 4 halvings in a row before that is the answer). The
+// tangent counts as singular against the structure's own scales (pivot_floor in the .cpp: a chain
+// of n elements has physical pivot ratios near 1 / (4 n^3)).
 //
 // What a converged result promises (result.ok):
 //  - balance: the residual is below tolerance x the load scale, or, where rounding keeps it

@@ -1,10 +1,11 @@
 // Segmented rods in three-dimensional large deflection, where twist and bending combine, converge
 // at second order in 1/N (docs/model.md "Validation"): the 45-degree bend of Bathe and Bolourchi
 // (1979) and Simo and Vu-Quoc (1986) under a tip load out of its plane, and a straight cantilever
-// under a tip force and a tip torque about its axis. Neither has a closed form: each test prints
-// the tip position at N segments, the changes between successive N, the observed order log2(d_{N/2}
-// / d_N) from three meshes and the Richardson extrapolation x_N + (x_N - x_{N/2}) / 3, and checks
-// the order at the finest meshes.
+// under a tip force out of the plane in which a tip torque bends it. Neither has a closed form:
+// each test prints the tip position at N segments, the changes between successive N, the observed
+// order log2(d_{N/2} / d_N) from three meshes and the Richardson extrapolation
+// x_N + (x_N - x_{N/2}) / 3, and checks the order at the finest meshes. Long chains of the bend
+// (256 and 512 chords) solve with automatic load steps, to the extrapolated limit.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -125,6 +126,33 @@ TEST(RotationConvergence, FortyFiveDegreeBendConvergesAtSecondOrder) {
   EXPECT_LT((finest - simo_vu_quoc).cwiseAbs().maxCoeff(), 0.5);
   // Exudyn's values are given to 0.01.
   EXPECT_LT((finest - exudyn).cwiseAbs().maxCoeff(), 0.01);
+}
+
+// Long chains: a 512-chord bend (3,072 degrees of freedom) failed at every load with "the tangent
+// stiffness is singular" (at load factor 1e-6), and 256 chords fell back to a dense minimum-norm
+// solve (24 s): the ratio of KLU's pivots, physical in a chain (about 1 / (4 n^3)), was taken for a
+// singularity. With automatic load steps both solve without a warning, to the limit that the
+// second-order extrapolation from 64 and 128 chords (20 load steps) gives.
+TEST(RotationConvergence, LongChordChainsSolveWithoutSpuriousSingularity) {
+  const double angle = std::numbers::pi / 4;
+  const Vec3 end(100 * std::sin(angle), 100 * (1 - std::cos(angle)), 0);
+  const Tip t64 = solve(bend(64, 600), 20, "n64", end),
+            t128 = solve(bend(128, 600), 20, "n128", end);
+  ASSERT_TRUE(t64.result.ok && t128.result.ok);
+  const Vec3 limit = t128.position + (t128.position - t64.position) / 3.0;
+  for (int segments : {256, 512}) {
+    const Tip t = solve(bend(segments, 600), 0, "n" + std::to_string(segments), end);
+    std::printf(
+        "%d chords, automatic load steps: ok = %d, %d load steps, %d iterations, %.2f s, tip "
+        "(%.6f, %.6f, %.6f), %.2e from the extrapolated limit%s%s\n",
+        segments, t.result.ok, t.result.load_steps, t.result.iterations, t.result.wall_seconds,
+        t.position(0), t.position(1), t.position(2), (t.position - limit).norm(),
+        t.result.ok ? "" : ": ", t.result.message.c_str());
+    ASSERT_TRUE(t.result.ok) << t.result.message;
+    EXPECT_EQ(t.result.singular_directions, 0);
+    EXPECT_TRUE(t.result.warnings.empty()) << t.result.warnings.front();
+    EXPECT_LT((t.position - limit).norm(), 1e-3);
+  }
 }
 
 // A straight steel cantilever, 1 m along x, 10 mm wide (y) and 15 mm high (z), cut into N segments

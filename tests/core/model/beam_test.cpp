@@ -169,6 +169,41 @@ TEST(Beam, LawsAreInvariantUnderARigidMotionOfBothBodies) {
   }
 }
 
+// A beam twisted 2.5 rad between its ends (body 2 turned about the element axis): under the energy
+// law phi is the pure twist (2.5, 0, 0) and the beam is inside its range, its wrenches a pure
+// torque G Ix / l * 2.5 about the axis on each body (no force, no bending moment); the paper's
+// angles give the same phi but are outside their range (1.5 rad).
+TEST(Beam, TwistedBeyondAQuarterTurnTheEnergyLawSeesPureTwist) {
+  Random rng(20);
+  for (int i = 0; i < 20; ++i) {
+    BeamCase s = random_case(rng, Formulation::kEnergy);
+    const ElementFrames<double> f0 =
+        element_frames(s.beam.ends, s.b1, s.b2, RotationMeasure::kRotationVector);
+    const Vec3 axis = f0.E1.col(0);
+    // Turn body 2 by 2.5 rad about the element axis through point 2.
+    const Mat3 r = rotation_matrix<double>(quat_from_rotation_vector(2.5 * axis));
+    const Vec3 p2 = s.b2.u + f0.R2;
+    Pose<double> b2 = s.b2;
+    b2.A = r * s.b2.A;
+    b2.u = p2 - r * f0.R2;
+    const ElementFrames<double> f =
+        element_frames(s.beam.ends, s.b1, b2, RotationMeasure::kRotationVector);
+    EXPECT_LT((f.phi - Vec3(2.5, 0, 0)).norm(), 1e-12) << f.phi.transpose();
+    EXPECT_FALSE(beam_out_of_range(s.beam, f));
+    const Wrenches w = evaluate(s.beam, s.b1, b2);
+    const double torque = s.beam.gj / s.beam.ends.length * 2.5;
+    EXPECT_LT(w.w1.head<3>().norm(), 1e-9 * torque);
+    EXPECT_LT((w.w2.tail<3>() + torque * axis).norm(), 1e-9 * torque);
+    EXPECT_LT((w.w1.tail<3>() - torque * axis - f.lever1.cross(w.w1.head<3>())).norm(),
+              1e-9 * torque);
+    Beam paper = s.beam;
+    paper.formulation = Formulation::kPaper;
+    const ElementFrames<double> fp = element_frames(paper.ends, s.b1, b2, rotation_measure(paper));
+    EXPECT_NEAR(fp.phi(0), 2.5, 1e-12);
+    EXPECT_TRUE(beam_out_of_range(paper, fp));
+  }
+}
+
 // Local end vectors at small deformation equal K1 delta and K2 delta (delta as the kernel measures
 // it, steps 3-4), and that delta equals the deformation imposed by moving body 2 (body 1 held).
 TEST(Beam, ForcesEqualStiffnessTimesDeformationWhenSmall) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "optimizer/study/design_study.hpp"
@@ -311,6 +312,11 @@ void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
         if (m.is_object() && m.contains("max_order"))
           method.label.append(" order<=").append(std::to_string(io.max_order));
         if (!io.about.empty()) method.label.append(" about ").append(io.about);
+        if (io.max_frequency_hz > 0.0) {
+          char band[48];
+          std::snprintf(band, sizeof band, " band %g Hz", io.max_frequency_hz);
+          method.label += band;
+        }
         if (io.linear_solver != LinearSolverKind::kAuto)
           method.label.append(io.linear_solver == LinearSolverKind::kDense ? " dense" : " sparse");
         p.methods.push_back(method);

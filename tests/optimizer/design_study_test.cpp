@@ -861,6 +861,28 @@ TEST_F(DesignStudyRuns, WorkPrecisionStudyTabulatesEveryMethodAndToleranceAgains
   EXPECT_EQ(summary["fastest_within_target"]["wall_seconds"].get<double>(), fastest);
 }
 
+// The band's trade in a work-precision table: a band-limited row is labelled with its band, takes
+// fewer steps than the full model and shows the error it costs against the full reference.
+TEST_F(DesignStudyRuns, WorkPrecisionShowsWhatABandCosts) {
+  Json s = small_work_precision();
+  s["scene"]["beams"][0]["segments"] = 10;
+  s["study"]["methods"] =
+      Json::parse(R"([{"method": "auto"}, {"method": "auto", "max_frequency_hz": 500}])");
+  s["study"]["rtols"] = Json{1e-6};
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
+  const Table t = read_table(dir_ / "wp" / "work_precision.csv");
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.at(0, "method"), "auto");
+  EXPECT_EQ(t.at(1, "method"), "auto band 500 Hz");
+  const double full = std::stod(t.at(0, "error")), band = std::stod(t.at(1, "error"));
+  std::printf("full model: error %.2e, %s steps; band 500 Hz: error %.2e, %s steps\n", full,
+              t.at(0, "steps").c_str(), band, t.at(1, "steps").c_str());
+  EXPECT_LT(full, 1e-6);
+  EXPECT_GT(band, 10 * full);  // the modes above 500 Hz, quasi-static, are what it leaves out
+  EXPECT_LT(band, 1e-3);
+  EXPECT_LT(std::stol(t.at(1, "steps")), std::stol(t.at(0, "steps")));
+}
+
 TEST_F(DesignStudyRuns, WorkPrecisionRunsPastTheirBudgetAreTimeoutRows) {
   Json s = small_work_precision();
   s["study"]["max_seconds"] = 1e-6;

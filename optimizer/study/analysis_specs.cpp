@@ -19,9 +19,9 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return;
   if (const auto m = r.choice("method", false, {"bdf", "adams", "dirk", "erk", "modal"}))
-    io.method = *m;
+    io.method = *method_from_name(*m);
   if (const auto t = r.string("table", false)) {
-    if (io.method != "dirk" && io.method != "erk")
+    if (io.method != IntegratorMethod::kDirk && io.method != IntegratorMethod::kErk)
       r.error("table", "a Butcher table applies to the \"dirk\" and \"erk\" methods");
     else
       io.table = *t;
@@ -38,23 +38,23 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
       io.linear_solver == LinearSolverKind::kSparse)
     r.error("jacobian", "finite-difference Jacobians need the dense linear solver");
   if (const auto q = r.integer("max_order", false, 1)) {
-    const int limit = io.method == "adams" ? 12 : 5;
-    if (io.method != "bdf" && io.method != "adams")
+    const int limit = io.method == IntegratorMethod::kAdams ? 12 : 5;
+    if (io.method != IntegratorMethod::kBdf && io.method != IntegratorMethod::kAdams)
       r.error("max_order", "applies to the \"bdf\" and \"adams\" methods");
     else if (*q > limit)
-      r.error("max_order", io.method + " orders go from 1 to " + std::to_string(limit));
+      r.error("max_order", std::string(method_name(io.method)) + " orders go from 1 to " + std::to_string(limit));
     else
       io.max_order = static_cast<int>(*q);
   }
   if (const auto d = r.boolean("stability_limit_detection", false)) {
-    if (io.method != "bdf") r.error("stability_limit_detection", "applies to the \"bdf\" method");
+    if (io.method != IntegratorMethod::kBdf) r.error("stability_limit_detection", "applies to the \"bdf\" method");
     io.stability_limit_detection = *d;
   }
   io.max_step = r.positive("max_step", false).value_or(0.0);
   io.initial_step = r.positive("initial_step", false).value_or(0.0);
   io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
   if (const auto about = r.choice("about", false, {"static", "initial"})) {
-    if (io.method != "modal")
+    if (io.method != IntegratorMethod::kModal)
       r.error("about", "applies to the \"modal\" method");
     else
       io.about = *about;
@@ -64,6 +64,7 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
 namespace {
 
 bool read_transient(ObjectReader& r, AnalysisSpec& a) {
+  const size_t problems_before = r.diagnostics().items().size();
   const auto t_end = r.positive("t_end", true);
   const auto step = r.positive("output_step", false);
   if (const Json* i = r.member("integrator", false))
@@ -81,6 +82,13 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
   }
   if (*t_end / a.transient.output_step > 1e8) {
     r.error("output_step", "more than 1e8 output rows requested");
+    return false;
+  }
+  // What the analysis itself refuses, when the checks above, which name the key at fault, found
+  // nothing.
+  std::string problem;
+  if (r.diagnostics().items().size() == problems_before && !a.transient.IsValid(&problem)) {
+    r.error("integrator", problem);
     return false;
   }
   return true;

@@ -51,9 +51,9 @@ class AutoIntegrator : public Integrator {
     sunctx_ = sunctx;
     const Model& model = c.model;
     if (model.n_free() == 0)
-      return start_implicit("bdf", "", 0.0, y0, "the scene has no free body", error);
+      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the scene has no free body", error);
     if (model.n_dofs > kModalIntegratorMaxDofs && !(o.max_frequency_hz > 0.0))
-      return start_implicit("bdf", "", 0.0, y0,
+      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
                             std::to_string(model.n_free()) +
                                 " free bodies: beyond the modal method's limit of " +
                                 std::to_string(kModalIntegratorMaxDofs / kDofsPerBody),
@@ -71,7 +71,7 @@ class AutoIntegrator : public Integrator {
         *error = why;
         return false;
       }
-      return start_implicit("bdf", "", 0.0, y0, "the modal method could not start: " + why, error);
+      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the modal method could not start: " + why, error);
     }
     std::string reason = std::to_string(model.n_free()) + " free bod" +
                          (model.n_free() == 1 ? "y" : "ies") +
@@ -82,7 +82,7 @@ class AutoIntegrator : public Integrator {
       const double step = 2.5 / (beta * highest);
       const double ratio = 0.5 * beta * std::sqrt(highest);
       if (ratio > kAutoMaxDampingRatio)
-        return start_implicit("bdf", "", 0.0, y0,
+        return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
                               "damping (beta " + number(beta) + " s) damps the fastest mode (" +
                                   number(std::sqrt(highest)) + " rad/s) at " + number(ratio) +
                                   " of critical: the modal method's explicit damping would hold "
@@ -119,7 +119,7 @@ class AutoIntegrator : public Integrator {
         short_runs_ = 0;
       } else if (short_runs_ >= 3) {
         std::string error;
-        if (!start_implicit("dirk", kAutoImplicitTable, *t, y,
+        if (!start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
                             "relinearizing every " + std::to_string(steps) + " steps (body " + who +
                                 " turns " + number(rotation_limit_) + " rad that fast)",
                             &error))
@@ -140,7 +140,7 @@ class AutoIntegrator : public Integrator {
       if (!next) {
         if (context_->timed_out || context_->interrupted) return fail(why);
         std::string error;
-        if (!start_implicit("dirk", kAutoImplicitTable, *t, y,
+        if (!start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
                             "the modal method could not relinearize: " + why, &error))
           return fail(error);
         continue;
@@ -174,7 +174,7 @@ class AutoIntegrator : public Integrator {
 
   IntegratorOptions modal_options() const {
     IntegratorOptions m = options_;
-    m.method = "modal";
+    m.method = IntegratorMethod::kModal;
     m.table.clear();
     m.max_rotation = rotation_limit_;
     m.max_steps = std::max(1L, options_.max_steps - before_.steps);
@@ -187,12 +187,14 @@ class AutoIntegrator : public Integrator {
   }
 
   // Goes on with an implicit method from (t, y).
-  bool start_implicit(const std::string& method, const std::string& table, double t, N_Vector y,
+  bool start_implicit(IntegratorMethod method, const std::string& table, double t, N_Vector y,
                       const std::string& reason, std::string* error) {
     IntegratorOptions o = options_;
     o.method = method;
     o.table = table;
     o.about.clear();
+    o.max_frequency_hz = 0.0;
+    o.max_rotation = 0.0;
     o.max_steps = std::max(1L, options_.max_steps - before_.steps);
     std::unique_ptr<Integrator> next = make_integrator(o, *context_, sunctx_, y, error);
     if (!next) return false;
@@ -202,7 +204,8 @@ class AutoIntegrator : public Integrator {
     modal_ = false;
     linear_solver = current_->linear_solver;
     nnz = current_->nnz;
-    record(t, table.empty() ? method : method + " " + table, reason);
+    const std::string name = method_name(method);
+    record(t, table.empty() ? name : name + " " + table, reason);
     return true;
   }
 

@@ -205,7 +205,7 @@ class Cvode : public SundialsIntegrator {
     context_ = &c;
     package_ = "CVODE";
     max_steps_ = std::max(1L, o.max_steps);
-    mem_ = CVodeCreate(o.method == "adams" ? CV_ADAMS : CV_BDF, ctx);
+    mem_ = CVodeCreate(o.method == IntegratorMethod::kAdams ? CV_ADAMS : CV_BDF, ctx);
     if (!mem_) return fail(error, "could not create CVODE");
     CVodeSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);
     if (CVodeInit(mem_, ode_rhs, 0.0, y0) < 0 || CVodeSStolerances(mem_, o.rtol, o.atol) < 0 ||
@@ -219,9 +219,9 @@ class Cvode : public SundialsIntegrator {
     nnz = c.structure ? c.structure->pattern().nnz() : 0;
     // |q| = 1 by projection (CVODE projects for BDF only; Adams states are renormalized when
     // the analysis restarts and the rotation uses q/|q| throughout).
-    if (o.method == "bdf") CVodeSetProjFn(mem_, ode_project);
-    CVodeSetMaxOrd(mem_, o.method == "adams" ? std::min(12, o.max_order) : o.max_order);
-    if (o.stability_limit_detection && o.method == "bdf") CVodeSetStabLimDet(mem_, SUNTRUE);
+    if (o.method == IntegratorMethod::kBdf) CVodeSetProjFn(mem_, ode_project);
+    CVodeSetMaxOrd(mem_, o.method == IntegratorMethod::kAdams ? std::min(12, o.max_order) : o.max_order);
+    if (o.stability_limit_detection && o.method == IntegratorMethod::kBdf) CVodeSetStabLimDet(mem_, SUNTRUE);
     if (o.max_step > 0.0) CVodeSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) CVodeSetInitStep(mem_, o.initial_step);
     return true;
@@ -366,13 +366,21 @@ std::unique_ptr<Integrator> build(const IntegratorOptions& o, OdeContext& c, SUN
 
 std::unique_ptr<Integrator> make_integrator(const IntegratorOptions& options, OdeContext& context,
                                             SUNContext sunctx, N_Vector y0, std::string* error) {
-  if (options.method == "bdf" || options.method == "adams")
-    return build<Cvode>(options, context, sunctx, y0, error);
-  if (options.method == "dirk") return build<ArkodeImplicit>(options, context, sunctx, y0, error);
-  if (options.method == "erk") return build<ArkodeExplicit>(options, context, sunctx, y0, error);
-  if (options.method == "modal") return make_modal_integrator(options, context, y0, error);
-  if (options.method == "auto") return make_auto_integrator(options, context, sunctx, y0, error);
-  *error = "unknown integrator method \"" + options.method + "\"";
+  if (!options.IsValid(error)) return nullptr;
+  switch (options.method) {
+    case IntegratorMethod::kBdf:
+    case IntegratorMethod::kAdams:
+      return build<Cvode>(options, context, sunctx, y0, error);
+    case IntegratorMethod::kDirk:
+      return build<ArkodeImplicit>(options, context, sunctx, y0, error);
+    case IntegratorMethod::kErk:
+      return build<ArkodeExplicit>(options, context, sunctx, y0, error);
+    case IntegratorMethod::kModal:
+      return make_modal_integrator(options, context, y0, error);
+    case IntegratorMethod::kAuto:
+      return make_auto_integrator(options, context, sunctx, y0, error);
+  }
+  *error = "unknown integrator method";
   return nullptr;
 }
 

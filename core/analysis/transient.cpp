@@ -39,10 +39,97 @@ std::vector<double> load_breakpoints(const Model& model, double t_end) {
 
 }  // namespace
 
+const char* method_name(IntegratorMethod method) {
+  switch (method) {
+    case IntegratorMethod::kBdf:
+      return "bdf";
+    case IntegratorMethod::kAdams:
+      return "adams";
+    case IntegratorMethod::kDirk:
+      return "dirk";
+    case IntegratorMethod::kErk:
+      return "erk";
+    case IntegratorMethod::kModal:
+      return "modal";
+    case IntegratorMethod::kAuto:
+      return "auto";
+  }
+  return "?";
+}
+
+std::optional<IntegratorMethod> method_from_name(const std::string& name) {
+  for (IntegratorMethod m : {IntegratorMethod::kBdf, IntegratorMethod::kAdams,
+                             IntegratorMethod::kDirk, IntegratorMethod::kErk,
+                             IntegratorMethod::kModal, IntegratorMethod::kAuto})
+    if (name == method_name(m)) return m;
+  return std::nullopt;
+}
+
+namespace {
+
+bool refuse(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+bool positive_finite(double x) { return x > 0.0 && std::isfinite(x); }
+bool zero_or_positive_finite(double x) { return x >= 0.0 && std::isfinite(x); }
+
+}  // namespace
+
+bool IntegratorOptions::IsValid(std::string* error) const {
+  const std::string name = method_name(method);
+  if (!method_from_name(name)) return refuse(error, "unknown integrator method");
+  if (!positive_finite(rtol)) return refuse(error, "rtol must be positive and finite");
+  if (!positive_finite(atol)) return refuse(error, "atol must be positive and finite");
+  const bool cvode = method == IntegratorMethod::kBdf || method == IntegratorMethod::kAdams;
+  const int limit = method == IntegratorMethod::kAdams ? 12 : 5;
+  if (cvode && (max_order < 1 || max_order > limit))
+    return refuse(error, name + " orders go from 1 to " + std::to_string(limit));
+  if (!table.empty() && method != IntegratorMethod::kDirk && method != IntegratorMethod::kErk)
+    return refuse(error, "a Butcher table applies to the \"dirk\" and \"erk\" methods");
+  if (stability_limit_detection && method != IntegratorMethod::kBdf)
+    return refuse(error, "stability_limit_detection applies to the \"bdf\" method");
+  if (jacobian == JacobianKind::kFiniteDifference && linear_solver == LinearSolverKind::kSparse)
+    return refuse(error, "finite-difference Jacobians need the dense linear solver");
+  if (!zero_or_positive_finite(max_step))
+    return refuse(error, "max_step must be 0 (no limit) or positive and finite");
+  if (!zero_or_positive_finite(initial_step))
+    return refuse(error, "initial_step must be 0 (the integrator's estimate) or positive");
+  if (max_steps < 1) return refuse(error, "max_steps must be at least 1");
+  if (!about.empty() && about != "static" && about != "initial")
+    return refuse(error, "about must be \"static\", \"initial\" or empty");
+  const bool modal = method == IntegratorMethod::kModal || method == IntegratorMethod::kAuto;
+  if (!about.empty() && !modal)
+    return refuse(error, "about applies to the \"modal\" and \"auto\" methods");
+  if (!zero_or_positive_finite(max_frequency_hz))
+    return refuse(error, "max_frequency_hz must be 0 (every mode) or positive and finite");
+  if (max_frequency_hz > 0.0 && !modal)
+    return refuse(error, "max_frequency_hz applies to the \"modal\" and \"auto\" methods");
+  if (!zero_or_positive_finite(max_rotation))
+    return refuse(error, "max_rotation must be 0 (the modal limit) or positive and finite");
+  return true;
+}
+
+bool TransientOptions::IsValid(std::string* error) const {
+  if (!positive_finite(t_end)) return refuse(error, "t_end must be positive and finite");
+  if (!positive_finite(output_step))
+    return refuse(error, "output_step must be positive and finite");
+  // An output step beyond t_end is one step, to t_end.
+  if (t_end / output_step > 1e8) return refuse(error, "more than 1e8 output rows requested");
+  if (!zero_or_positive_finite(max_seconds))
+    return refuse(error, "max_seconds must be 0 (no budget) or positive and finite");
+  return integrator.IsValid(error);
+}
+
 TransientResult run_transient(const Model& model, const TransientOptions& options, Data& data,
                               const TransientObserver& observer) {
   TransientResult result;
   const auto start = std::chrono::steady_clock::now();
+  if (!options.IsValid(&result.message)) {
+    result.message = "invalid transient options: " + result.message;
+    return result;
+  }
   const IntegratorOptions& io = options.integrator;
   DeformationCheck deformation(model);
   try {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,16 @@ namespace beamrail {
 enum class JacobianKind { kExact, kFiniteDifference };
 enum class LinearSolverKind { kAuto, kDense, kSparse };
 
+// The integrator families: CVODE's BDF and Adams, ARKODE's diagonally implicit and explicit
+// Runge-Kutta methods, the modal integrator (core/analysis/modal_integrator.hpp) and auto, which
+// chooses among them per scene and per phase (core/analysis/auto_integrator.hpp).
+enum class IntegratorMethod { kBdf, kAdams, kDirk, kErk, kModal, kAuto };
+
+// The method's name in study files and tables: "bdf", "adams", "dirk", "erk", "modal", "auto".
+const char* method_name(IntegratorMethod method);
+// The method named `name`, nullopt for any other text.
+std::optional<IntegratorMethod> method_from_name(const std::string& name);
+
 // Defaults of the integrator families (measured: see README "Speed and accuracy, measured").
 inline constexpr const char* kDefaultDirkTable = "ARK548L2SA_DIRK_8_4_5";
 inline constexpr const char* kDefaultErkTable = "DORMAND_PRINCE_7_4_5";
@@ -27,11 +38,11 @@ inline constexpr long kSparseStateThreshold = 26;
 
 struct IntegratorOptions {
   // bdf | adams (CVODE), dirk | erk (ARKODE), modal, auto (core/analysis/auto_integrator.hpp).
-  // A study's transient defaults to auto (optimizer/analysis_specs.cpp); this struct to bdf.
-  std::string method = "bdf";
-  std::string table;   // dirk/erk: ARKODE Butcher table name ("" = default)
-  double rtol = 1e-6;  // relative tolerance
-  double atol = 1e-9;  // absolute tolerance (states in m, -, m/s, rad/s)
+  // A study's transient defaults to auto (optimizer/study/analysis_specs.cpp); this struct to bdf.
+  IntegratorMethod method = IntegratorMethod::kBdf;
+  std::string table;           // dirk/erk: ARKODE Butcher table name ("" = default)
+  double rtol = 1e-6;          // relative tolerance
+  double atol = 1e-9;          // absolute tolerance (states in m, -, m/s, rad/s)
   JacobianKind jacobian = JacobianKind::kExact;
   LinearSolverKind linear_solver = LinearSolverKind::kAuto;
   int max_order = 5;                       // BDF order limit 1..5 (Adams: 1..12)
@@ -49,6 +60,11 @@ struct IntegratorOptions {
   // modal, auto: the band integrated [Hz]; the modes above it are quasi-static (their static
   // response kept, their dynamics dropped). 0: every mode.
   double max_frequency_hz = 0.0;
+
+  // Whether the options can run: true, or false with the first problem in *error (a tolerance
+  // not positive, an order outside the method's range, an option of another method). The
+  // transient analysis refuses options that are not valid; the study reader reports them.
+  bool IsValid(std::string* error) const;
 };
 
 struct TransientOptions {
@@ -62,6 +78,10 @@ struct TransientOptions {
   // The state at t = 0 (dim model.n_states; initial_state_at makes one from a static
   // equilibrium); empty: the model's initial state.
   std::vector<double> initial_state;
+
+  // Whether the options can run (t_end and output_step positive and finite, at most 1e8 output
+  // steps, the integrator's options valid): true, or false with the first problem in *error.
+  bool IsValid(std::string* error) const;
 };
 
 // Energies at one output time [J].

@@ -21,9 +21,11 @@ using DesignDone = std::function<bool(long index, const DesignOutcome& outcome)>
 // What an executor measured of the batches it ran.
 struct ExecutorStats {
   std::vector<long> designs_per_rank;  // outcomes handed back from each rank
-  // Rank 0's time spent scheduling (sending designs, receiving and unpacking outcomes; not
-  // evaluating, not the `done` callback) [s]; 0 for threads of one process.
+  // Rank 0's CPU time spent scheduling (sending designs, polling for, receiving and unpacking
+  // outcomes; not evaluating, not the `done` callback) [s]; 0 for threads of one process.
   double scheduler_seconds = 0.0;
+  // Rank 0's CPU time spent polling for outcomes while none came [s].
+  double polling_seconds = 0.0;
 };
 
 class BatchExecutor {
@@ -57,7 +59,7 @@ class ThreadExecutor : public BatchExecutor {
 
  private:
   int threads_;
-  ExecutorStats stats_{{0}, 0.0};
+  ExecutorStats stats_{{0}, 0.0, 0.0};
 };
 
 // Evaluates one design, a thrown exception becoming a kFailed outcome.

@@ -18,6 +18,8 @@
 #include <thread>
 #include <vector>
 
+#include <time.h>
+
 #include "core/analysis/stop_request.hpp"
 #endif
 
@@ -54,18 +56,25 @@ class Packer {
  public:
   template <typename T>
   void put(T value) {
-    const char* p = reinterpret_cast<const char*>(&value);
-    bytes.insert(bytes.end(), p, p + sizeof(T));
+    append(&value, sizeof(T));
   }
   void put_string(const std::string& s) {
     put<int64_t>(static_cast<int64_t>(s.size()));
-    bytes.insert(bytes.end(), s.begin(), s.end());
+    append(s.data(), s.size());
   }
   void put_doubles(const std::vector<double>& v) {
     put<int64_t>(static_cast<int64_t>(v.size()));
     for (double x : v) put(x);
   }
   std::vector<char> bytes;
+
+ private:
+  void append(const void* data, size_t n) {
+    if (n == 0) return;
+    const size_t at = bytes.size();
+    bytes.resize(at + n);
+    std::memcpy(bytes.data() + at, data, n);
+  }
 };
 
 class Unpacker {
@@ -135,6 +144,14 @@ void send(const std::vector<char>& bytes, int rank, int tag) {
   MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, rank, tag, MPI_COMM_WORLD);
 }
 
+// CPU time of the calling thread [s]: what scheduling costs rank 0, not counting the time the
+// system gives its cores to other threads (on an oversubscribed machine, most of the wall time).
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 // Polling waits: MPI's blocking receives spin on a core, which a rank's evaluating threads need.
 // A loop that found nothing sleeps, twice as long each time up to `longest`.
 class Backoff {
@@ -164,8 +181,7 @@ class MpiExecutor : public BatchExecutor {
                 const DesignDone& done) override {
     const int size = job_.size();
     stats_.designs_per_rank.resize(size, 0);
-    using Clock = std::chrono::steady_clock;
-    auto scheduling = Clock::duration::zero();
+    double scheduling = 0.0, polling = 0.0;  // CPU seconds
     if (!job_.study_sent) {
       const Study& study = evaluator.study();
       Packer p;
@@ -200,9 +216,10 @@ class MpiExecutor : public BatchExecutor {
     std::vector<int> ahead(size, 0);
     long pending = 0;  // designs sent and not back yet
     bool exhausted = false;
-    Backoff backoff(std::chrono::microseconds(200));
+    Backoff backoff(std::chrono::microseconds(1000));
     while (true) {
-      const auto busy = Clock::now();
+      const double busy = thread_cpu_seconds();
+      const long pending_before = pending;
       for (int r = 1; r < size && !exhausted; ++r)
         while (ahead[r] < threads_ + 1) {
           const long i = take();
@@ -225,17 +242,19 @@ class MpiExecutor : public BatchExecutor {
         const long i = unpack_result(receive(probed), &o);
         --ahead[probed.MPI_SOURCE];
         --pending;
-        scheduling += Clock::now() - busy;
+        scheduling += thread_cpu_seconds() - busy;
         deliver(probed.MPI_SOURCE, i, o);
         backoff.reset();
         continue;
       }
-      scheduling += Clock::now() - busy;
+      // A loop that sent nothing and found nothing is polling, not scheduling a design.
+      (pending != pending_before ? scheduling : polling) += thread_cpu_seconds() - busy;
       if (exhausted && pending == 0) break;
       std::this_thread::sleep_for(backoff.next());
     }
     for (std::thread& t : pool) t.join();
-    stats_.scheduler_seconds += std::chrono::duration<double>(scheduling).count();
+    stats_.scheduler_seconds += scheduling;
+    stats_.polling_seconds += polling;
   }
 
  private:

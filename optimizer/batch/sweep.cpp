@@ -115,6 +115,7 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   if (executor->ranks() > 1) {
     s["designs_per_rank"] = stats.designs_per_rank;
     s["scheduler_seconds"] = stats.scheduler_seconds;
+    s["polling_seconds"] = stats.polling_seconds;
   }
   s["wall_seconds"] = wall;
   s["evaluations_per_second"] = wall > 0 ? static_cast<double>(evaluated) / wall : 0.0;

@@ -131,7 +131,7 @@ int run_work_precision(const Study& study, const RunSettings& settings) {
   summary["failed_or_timeout"] = failed;
   summary["target_error"] = plan.target_error;
   summary["fastest_within_target"] = best;
-  summary["reference"] = {{"method", plan.reference.method},
+  summary["reference"] = {{"method", method_name(plan.reference.method)},
                           {"rtol", plan.reference.rtol},
                           {"atol", plan.reference.atol},
                           {"wall_seconds", reference.result.stats.wall_seconds},

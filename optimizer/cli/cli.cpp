@@ -245,8 +245,9 @@ int run(const RunArguments& args) {
   // Under mpirun the other ranks evaluate a sweep's designs; anything else runs here alone.
   const bool sweep = study->design && study->design->type == DesignStudy::Type::kSweep;
   if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !sweep)
-    std::cerr << "beamrail: only sweeps spread over MPI ranks so far; this study runs on rank 0 ("
-              << job->size() - 1 << " ranks stay idle)\n";
+    std::cerr << "beamrail: only sweeps spread over MPI ranks so far; this study runs on rank 0 "
+                 "alone (the other "
+              << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {
     int status = 0;

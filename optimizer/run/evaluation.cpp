@@ -344,7 +344,7 @@ class Runner {
     if (result.interrupted)
       report.message = "interrupted at t = " + format_number(result.t_reached) + " s";
     report.stats = result.stats;
-    report.integrator = options.integrator.method;
+    report.integrator = method_name(options.integrator.method);
     if (!options.integrator.table.empty()) report.integrator += " " + options.integrator.table;
     report.linear_solver = result.linear_solver;
     report.phases = result.phases;

@@ -19,9 +19,9 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return;
   if (const auto m = r.choice("method", false, {"auto", "bdf", "adams", "dirk", "erk", "modal"}))
-    io.method = *m;
+    io.method = *method_from_name(*m);
   if (const auto t = r.string("table", false)) {
-    if (io.method != "dirk" && io.method != "erk")
+    if (io.method != IntegratorMethod::kDirk && io.method != IntegratorMethod::kErk)
       r.error("table", "a Butcher table applies to the \"dirk\" and \"erk\" methods");
     else
       io.table = *t;
@@ -38,16 +38,16 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
       io.linear_solver == LinearSolverKind::kSparse)
     r.error("jacobian", "finite-difference Jacobians need the dense linear solver");
   if (const auto q = r.integer("max_order", false, 1)) {
-    const int limit = io.method == "adams" ? 12 : 5;
-    if (io.method != "bdf" && io.method != "adams")
+    const int limit = io.method == IntegratorMethod::kAdams ? 12 : 5;
+    if (io.method != IntegratorMethod::kBdf && io.method != IntegratorMethod::kAdams)
       r.error("max_order", "applies to the \"bdf\" and \"adams\" methods");
     else if (*q > limit)
-      r.error("max_order", io.method + " orders go from 1 to " + std::to_string(limit));
+      r.error("max_order", std::string(method_name(io.method)) + " orders go from 1 to " + std::to_string(limit));
     else
       io.max_order = static_cast<int>(*q);
   }
   if (const auto d = r.boolean("stability_limit_detection", false)) {
-    if (io.method != "bdf") r.error("stability_limit_detection", "applies to the \"bdf\" method");
+    if (io.method != IntegratorMethod::kBdf) r.error("stability_limit_detection", "applies to the \"bdf\" method");
     io.stability_limit_detection = *d;
   }
   io.max_step = r.positive("max_step", false).value_or(0.0);
@@ -55,14 +55,14 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
   if (r.member("max_frequency_hz", false)) {
     if (const auto f = r.positive("max_frequency_hz", false)) {
-      if (io.method != "modal" && io.method != "auto")
+      if (io.method != IntegratorMethod::kModal && io.method != IntegratorMethod::kAuto)
         r.error("max_frequency_hz", "applies to the \"modal\" and \"auto\" methods");
       else
         io.max_frequency_hz = *f;
     }
   }
   if (const auto about = r.choice("about", false, {"static", "initial"})) {
-    if (io.method != "modal" && io.method != "auto")
+    if (io.method != IntegratorMethod::kModal && io.method != IntegratorMethod::kAuto)
       r.error("about", "applies to the \"modal\" and \"auto\" methods");
     else
       io.about = *about;
@@ -72,9 +72,10 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
 namespace {
 
 bool read_transient(ObjectReader& r, AnalysisSpec& a) {
+  const size_t problems_before = r.diagnostics().items().size();
   const auto t_end = r.positive("t_end", true);
   const auto step = r.positive("output_step", false);
-  a.transient.integrator.method = "auto";  // the study file's default (docs/study_files.md)
+  a.transient.integrator.method = IntegratorMethod::kAuto;  // the study file's default (docs/study_files.md)
   if (const Json* i = r.member("integrator", false))
     read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
   a.verify = r.boolean("verify", false).value_or(false);
@@ -91,7 +92,7 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
       band = r.positive("max_frequency_hz", false).value_or(-1.0);
     }
     const IntegratorOptions& io = a.transient.integrator;
-    if (band >= 0.0 && io.method != "modal" && io.method != "auto") {
+    if (band >= 0.0 && io.method != IntegratorMethod::kModal && io.method != IntegratorMethod::kAuto) {
       r.error("max_frequency_hz", "applies to the \"modal\" and \"auto\" methods");
       band = -1.0;
     }
@@ -110,6 +111,13 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
   }
   if (*t_end / a.transient.output_step > 1e8) {
     r.error("output_step", "more than 1e8 output rows requested");
+    return false;
+  }
+  // What the analysis itself refuses, when the checks above, which name the key at fault, found
+  // nothing.
+  std::string problem;
+  if (r.diagnostics().items().size() == problems_before && !a.transient.IsValid(&problem)) {
+    r.error("integrator", problem);
     return false;
   }
   return true;

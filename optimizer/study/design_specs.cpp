@@ -307,7 +307,7 @@ void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
         WorkPrecisionPlan::Method method;
         read_integrator(m, at, r.diagnostics(), method.integrator);
         const IntegratorOptions& io = method.integrator;
-        method.label = io.method;
+        method.label = method_name(io.method);
         if (!io.table.empty()) method.label.append(" ").append(io.table);
         if (m.is_object() && m.contains("max_order"))
           method.label.append(" order<=").append(std::to_string(io.max_order));

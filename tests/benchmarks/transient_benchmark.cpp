@@ -49,7 +49,7 @@ const TipPath& tight_run(int segments) {
   auto it = cache.find(segments);
   if (it == cache.end()) {
     IntegratorOptions io;
-    io.method = "erk";
+    io.method = IntegratorMethod::kErk;
     io.table = "VERNER_8_5_6";
     io.rtol = 1e-11;
     io.atol = 1e-12;
@@ -75,7 +75,7 @@ void ReferenceProblem(benchmark::State& state, const char* method, const char* t
   const int segments = static_cast<int>(state.range(0));
   const Model model = bench::reference_model(segments);
   IntegratorOptions io;
-  io.method = method;
+  io.method = *method_from_name(method);
   io.table = table;
   io.rtol = rtol;
   io.atol = 1e-2 * rtol;

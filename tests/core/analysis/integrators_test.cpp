@@ -58,7 +58,7 @@ TEST(Integrators, EveryFamilyIntegratesTheSameMotion) {
   };
   for (const Family& f : families) {
     TransientOptions o = options(0.05, 5e-4, 1e-8, 1e-10);
-    o.integrator.method = f.method;
+    o.integrator.method = *method_from_name(f.method);
     o.integrator.table = f.table;
     o.integrator.linear_solver = f.solver;
     o.integrator.jacobian = f.jacobian;

@@ -25,7 +25,7 @@ using testing::TransientRun;
 
 TransientOptions modal(double t_end, double output_step, double rtol, double atol) {
   TransientOptions o = options(t_end, output_step, rtol, atol);
-  o.integrator.method = "modal";
+  o.integrator.method = IntegratorMethod::kModal;
   return o;
 }
 
@@ -33,7 +33,7 @@ TransientOptions modal(double t_end, double output_step, double rtol, double ato
 TransientRun tight_reference(const Model& model, double t_end, double output_step, double rtol,
                              double atol) {
   TransientOptions o = options(t_end, output_step, rtol, atol);
-  o.integrator.method = "erk";
+  o.integrator.method = IntegratorMethod::kErk;
   o.integrator.table = "VERNER_8_5_6";
   return simulate(model, o);
 }

@@ -96,7 +96,7 @@ TEST(NonConservativeLoads, TipTorqueModesAreThoseOfTheNonSymmetricProblem) {
   s.j["loads"][1]["time"] = {
       {"type", "table"}, {"t", {5.0, 5.001, 5.01, 5.011}}, {"v", {0, 1, 1, 0}}};
   TransientOptions o = testing::options(8.0, 1e-3, 1e-9, 1e-12);
-  o.integrator.method = "dirk";
+  o.integrator.method = IntegratorMethod::kDirk;
   const Model moving = s.model();
   const testing::TransientRun run = testing::simulate(moving, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;
@@ -144,7 +144,7 @@ TEST(NonConservativeLoads, BeamBentIntoACircleByATipTorqueIsStable) {
   ramped.j["loads"][0]["time"] = {{"type", "ramp"}, {"from", 0}, {"to", 4}};
   ramped.force("tip", Vec3(0, 0, 0.01));
   TransientOptions o = testing::options(8.0, 0.01, 1e-5, 1e-8);
-  o.integrator.method = "dirk";
+  o.integrator.method = IntegratorMethod::kDirk;
   const Model moving = ramped.model();
   const testing::TransientRun run = testing::simulate(moving, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;
@@ -224,7 +224,7 @@ TEST(NonConservativeLoads, FlutterGrowthRateIsTheTransients) {
   s.last_body()["velocity"] = testing::vec(0, 1e-3, 0);
   s.j["loads"][0]["time"] = {{"type", "ramp"}, {"from", 0}, {"to", 0.5}};
   TransientOptions o = testing::options(8.0, 2e-3, 1e-6, 1e-9);
-  o.integrator.method = "dirk";
+  o.integrator.method = IntegratorMethod::kDirk;
   const Model moving = s.model();
   const testing::TransientRun run = testing::simulate(moving, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;

@@ -244,7 +244,7 @@ TEST(SparseStructureCache, ARunWithASharedStructureIsTheRunWithout) {
   const Model model = scene_from_json(reference_cantilever(6));
   TransientOptions o = testing::options(0.02, 1e-3, 1e-7, 1e-10);
   o.integrator.linear_solver = LinearSolverKind::kSparse;
-  o.integrator.method = "dirk";
+  o.integrator.method = IntegratorMethod::kDirk;
   const testing::TransientRun alone = testing::simulate(model, o);
   SparseStructureCache cache;
   o.structure_cache = &cache;

@@ -38,7 +38,7 @@ double error_of(const Model& model, const TransientRun& run, const TransientRun&
 
 TransientRun tight(const Model& model, double t_end, double output_step, double rtol = 1e-11) {
   TransientOptions o = options(t_end, output_step, rtol, 1e-2 * rtol);
-  o.integrator.method = "erk";
+  o.integrator.method = IntegratorMethod::kErk;
   o.integrator.table = "VERNER_8_5_6";
   return simulate(model, o);
 }
@@ -46,7 +46,7 @@ TransientRun tight(const Model& model, double t_end, double output_step, double 
 TransientRun run_with(const Model& model, const std::string& method, double t_end,
                       double output_step, double rtol, double band = 0.0) {
   TransientOptions o = options(t_end, output_step, rtol, 1e-2 * rtol);
-  o.integrator.method = method;
+  o.integrator.method = *method_from_name(method);
   o.integrator.max_frequency_hz = band;
   return simulate(model, o);
 }

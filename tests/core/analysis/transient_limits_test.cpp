@@ -1,10 +1,13 @@
 // How a transient run ends when it cannot go on: the step budget max_steps holds for the whole
-// run (across output steps and the restarts at load jumps), a load that overflows ends the run as
+// run (across output steps and the restarts at load jumps), options that cannot run are refused
+// before anything runs, a load that overflows ends the run as
 // failed in bounded time, the integrators' flags come out in words, and a stop request ends the
 // run as interrupted with the samples delivered so far.
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,6 +20,7 @@ namespace {
 
 using testing::scene_from_json;
 using testing::simulate;
+using testing::TransientRun;
 
 // A steel cantilever (1 m, 10 mm square) with a 1 kg tip body; `loads` is spliced in.
 Model cantilever(const std::string& loads) {
@@ -35,7 +39,7 @@ TransientOptions run_options(const std::string& method, double t_end, double out
   TransientOptions o;
   o.t_end = t_end;
   o.output_step = output_step;
-  o.integrator.method = method;
+  o.integrator.method = *method_from_name(method);
   o.max_seconds = 60.0;  // a guard: every run here ends in well under a second
   return o;
 }
@@ -159,6 +163,57 @@ TEST(TransientLimits, AStopRequestEndsTheRunAsInterrupted) {
     EXPECT_EQ(samples, 5);
     EXPECT_LT(r.t_reached, 0.05 + 1e-12);
   }
+}
+
+// Options a C++ caller gets wrong are refused before anything runs (TransientOptions::IsValid),
+// the reason naming the option: an output step of 0 (its step count would be an undefined
+// float-to-int conversion), non-finite or negative times and tolerances, an order beyond the
+// method's range, an option of another method. No sample is delivered.
+TEST(TransientLimits, OptionsThatCannotRunAreRefusedNamingTheOption) {
+  const Model model = cantilever(R"([{"type": "force", "body": "tip", "value": [0, -1, 0]}])");
+  struct Case {
+    const char* named;
+    std::function<void(TransientOptions&)> spoil;
+  };
+  const Case cases[] = {
+      {"output_step", [](TransientOptions& o) { o.output_step = 0.0; }},
+      {"output_step", [](TransientOptions& o) { o.output_step = -1e-3; }},
+      {"output_step", [](TransientOptions& o) { o.output_step = NAN; }},
+      {"t_end", [](TransientOptions& o) { o.t_end = INFINITY; }},
+      {"1e8 output rows", [](TransientOptions& o) { o.output_step = 1e-12; }},
+      {"max_seconds", [](TransientOptions& o) { o.max_seconds = -1.0; }},
+      {"rtol", [](TransientOptions& o) { o.integrator.rtol = 0.0; }},
+      {"atol", [](TransientOptions& o) { o.integrator.atol = NAN; }},
+      {"orders go from 1 to 5", [](TransientOptions& o) { o.integrator.max_order = 6; }},
+      {"orders go from 1 to 12",
+       [](TransientOptions& o) {
+         o.integrator.method = IntegratorMethod::kAdams;
+         o.integrator.max_order = 13;
+       }},
+      {"stability_limit_detection",
+       [](TransientOptions& o) {
+         o.integrator.method = IntegratorMethod::kDirk;
+         o.integrator.stability_limit_detection = true;
+       }},
+      {"max_steps", [](TransientOptions& o) { o.integrator.max_steps = 0; }},
+      {"about", [](TransientOptions& o) { o.integrator.about = "static"; }},
+  };
+  std::string why;
+  ASSERT_TRUE(run_options("bdf", 0.01, 1e-3).IsValid(&why)) << why;
+  for (const Case& c : cases) {
+    TransientOptions o = run_options("bdf", 0.01, 1e-3);
+    c.spoil(o);
+    why.clear();
+    EXPECT_FALSE(o.IsValid(&why)) << c.named;
+    EXPECT_NE(why.find(c.named), std::string::npos) << c.named << ": " << why;
+    const TransientRun run = simulate(model, o);
+    EXPECT_FALSE(run.result.ok) << c.named;
+    EXPECT_TRUE(run.samples.empty()) << c.named;
+    EXPECT_NE(run.result.message.find(c.named), std::string::npos) << run.result.message;
+  }
+  for (const char* name : {"bdf", "adams", "dirk", "erk", "modal"})
+    EXPECT_STREQ(method_name(*method_from_name(name)), name);
+  EXPECT_FALSE(method_from_name("rk4"));
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ TransientOptions options(const std::string& method, double t_end, double output_
   TransientOptions o;
   o.t_end = t_end;
   o.output_step = output_step;
-  o.integrator.method = method;
+  o.integrator.method = *method_from_name(method);
   o.integrator.rtol = 1e-8;
   o.integrator.atol = 1e-10;
   o.max_seconds = 60.0;  // a guard: every run here ends in well under a second

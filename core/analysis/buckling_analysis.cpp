@@ -214,10 +214,31 @@ BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, 
   return out;
 }
 
+namespace {
+
+bool refuse_options(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+}  // namespace
+
+bool BucklingOptions::IsValid(std::string* error) const {
+  if (modes < 1) return refuse_options(error, "modes must be at least 1");
+  if (std::isnan(time)) return refuse_options(error, "time must be a number");
+  if (!(max_seconds >= 0.0 && std::isfinite(max_seconds)))
+    return refuse_options(error, "max_seconds must be 0 (no budget) or positive and finite");
+  return true;
+}
+
 BucklingResult solve_buckling(const Model& reference, const Model& scaled,
                               const BucklingOptions& options, Data& data) {
   const auto start = Clock::now();
   BucklingResult result;
+  if (!options.IsValid(&result.message)) {
+    result.message = "invalid buckling options: " + result.message;
+    return result;
+  }
   const Deadline deadline(start, options.max_seconds);
   try {
     const double t = options.time;

@@ -47,6 +47,9 @@ struct BucklingOptions {
                                                           // buckling_dense_is_faster
   double time = std::numeric_limits<double>::infinity();  // loads' time
   double max_seconds = 0.0;  // wall-clock budget [s]; 0: none (result.timed_out when spent)
+  // Whether the options can run: true, or false with the first problem in *error. The analysis
+  // refuses options that are not valid; the study reader reports them.
+  bool IsValid(std::string* error) const;
 };
 
 struct BucklingMode {

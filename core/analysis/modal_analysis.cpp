@@ -429,9 +429,31 @@ const Mode* elastic_mode(const ModalResult& result, int k) {
   return nullptr;
 }
 
+namespace {
+
+bool refuse_options(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+}  // namespace
+
+bool ModalOptions::IsValid(std::string* error) const {
+  if (modes < 1) return refuse_options(error, "modes must be at least 1");
+  if (std::isnan(time)) return refuse_options(error, "time must be a number");
+  if (!std::isfinite(load_factor)) return refuse_options(error, "load_factor must be finite");
+  if (!(max_seconds >= 0.0 && std::isfinite(max_seconds)))
+    return refuse_options(error, "max_seconds must be 0 (no budget) or positive and finite");
+  return true;
+}
+
 ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& data) {
   const auto start = Clock::now();
   ModalResult result;
+  if (!options.IsValid(&result.message)) {
+    result.message = "invalid modal options: " + result.message;
+    return result;
+  }
   const Deadline budget(start, options.max_seconds);
   try {
     compute_wrenches(model, data, options.time, options.load_factor);

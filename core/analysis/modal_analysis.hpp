@@ -54,6 +54,9 @@ struct ModalOptions {
   double load_factor = 1.0;  // 0: linearize the unloaded structure (no load stiffness)
   double max_seconds = 0.0;  // wall-clock budget [s]; 0: none (result.timed_out when spent)
   bool keep_mass = false;    // keep M in the result (to compare shapes)
+  // Whether the options can run: true, or false with the first problem in *error. The analysis
+  // refuses options that are not valid; the study reader reports them.
+  bool IsValid(std::string* error) const;
 };
 
 struct Mode {

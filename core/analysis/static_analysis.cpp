@@ -510,9 +510,34 @@ Stability stability(const Model& model, Data& data, double t) {
 
 }  // namespace
 
+namespace {
+
+bool refuse_options(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+}  // namespace
+
+bool StaticOptions::IsValid(std::string* error) const {
+  if (std::isnan(time)) return refuse_options(error, "time must be a number");
+  if (load_steps < 0) return refuse_options(error, "load_steps must be 0 (automatic) or more");
+  if (max_iterations < 1) return refuse_options(error, "max_iterations must be at least 1");
+  if (!(tolerance > 0.0 && std::isfinite(tolerance)))
+    return refuse_options(error, "tolerance must be positive and finite");
+  if (max_load_steps < 1) return refuse_options(error, "max_load_steps must be at least 1");
+  if (!(max_seconds >= 0.0 && std::isfinite(max_seconds)))
+    return refuse_options(error, "max_seconds must be 0 (no budget) or positive and finite");
+  return true;
+}
+
 StaticResult solve_static(const Model& model, const StaticOptions& options, Data& data) {
   const auto start = Clock::now();
   StaticResult result;
+  if (!options.IsValid(&result.message)) {
+    result.message = "invalid static options: " + result.message;
+    return result;
+  }
   const Deadline budget(start, options.max_seconds);
   try {
     reset_to_initial(model, data);

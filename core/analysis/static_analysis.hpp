@@ -46,6 +46,9 @@ struct StaticOptions {
   // Shares the tangent's sparse pattern and KLU ordering between analyses of one topology
   // (designs); nullptr: this analysis makes its own.
   SparseStructureCache* structure_cache = nullptr;
+  // Whether the options can run: true, or false with the first problem in *error. The analysis
+  // refuses options that are not valid; the study reader reports them.
+  bool IsValid(std::string* error) const;
 };
 
 struct StaticResult {

@@ -261,6 +261,17 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
     a.type = AnalysisSpec::Type::kBuckling;
     ok = read_buckling(r, model, a) && ok;
   }
+  // What the analysis itself refuses, once the reader's checks, which name the key at fault, pass
+  // (a transient's options are checked in read_transient).
+  std::string problem;
+  const bool valid = a.type == AnalysisSpec::Type::kStatic   ? a.statics.IsValid(&problem)
+                     : a.type == AnalysisSpec::Type::kModal  ? a.modal.IsValid(&problem)
+                     : a.type == AnalysisSpec::Type::kBuckling ? a.buckling.IsValid(&problem)
+                                                               : true;
+  if (ok && !valid) {
+    r.error("type", problem);
+    ok = false;
+  }
   if (!ok) return std::nullopt;
   return a;
 }

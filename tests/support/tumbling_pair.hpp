@@ -1,6 +1,6 @@
-// A rotating scene for the transient tests: the tumbling pair of conservation_test.cpp (energy
-// formulation), two bodies joined by a 5 mm steel rod, spinning at ~2.7 rad/s about their centre
-// of mass while the rod bends and twists by a few hundredths of a radian.
+// A rotating scene for the transient tests: two bodies joined by a 5 mm steel rod, tumbling together
+// (spinning at ~2.7 rad/s about their common centre of mass) while body b also swings relative to
+// a, so the rod bends and twists by a few hundredths of a radian. The rod's law: `formulation`.
 #pragma once
 
 #include <cstdio>
@@ -16,7 +16,7 @@ inline std::string vec3(const Vec3& v) {
   return buf;
 }
 
-inline std::string tumbling_pair_scene() {
+inline std::string tumbling_pair_scene(const std::string& formulation = "energy") {
   const double ma = 1.0, mb = 2.0;
   const Vec3 ca(0, 0, 0), cb(0.5, 0.05, -0.03);
   const Vec4 qb = Vec4(0.9, 0.1, -0.3, 0.2).normalized();
@@ -37,6 +37,7 @@ inline std::string tumbling_pair_scene() {
          vec3(vb) + R"(, "angular_velocity": )" + vec3(wb) + R"(}],
     "beams": [{"name": "ab", "body1": "a", "body2": "b", "point1": [0.1, 0, 0],
                "point2": [0.4, 0.05, -0.03], "point3": [0.1, 1, 0.2], "material": "steel",
-               "section": "rod"}]})";
+               "section": "rod", "formulation": ")" +
+         formulation + R"("}]})";
 }
 }  // namespace beamrail::testing

@@ -7,45 +7,14 @@
 
 #include "core/model/beam.hpp"
 #include "tests/support/transient_run.hpp"
+#include "tests/support/tumbling_pair.hpp"
 
 namespace beamrail {
 namespace {
 
 using testing::Snapshot;
 using testing::TransientRun;
-
-std::string vec(const Vec3& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "[%.17g, %.17g, %.17g]", v(0), v(1), v(2));
-  return buf;
-}
-
-// Two bodies joined by one beam, tumbling together (spin about the common centre of mass) with
-// body b also swinging relative to a, so the beam bends and twists by a few hundredths of a rad.
-std::string tumbling_pair(const std::string& formulation) {
-  const double ma = 1.0, mb = 2.0;
-  const Vec3 ca(0, 0, 0), cb(0.5, 0.05, -0.03);
-  const Vec4 qb = Vec4(0.9, 0.1, -0.3, 0.2).normalized();
-  const Mat3 ab = rotation_matrix<double>(qb);
-  const Vec3 com = (ma * ca + mb * cb) / (ma + mb);
-  const Vec3 spin(1.0, 2.0, 1.5), drift(0.3, -0.2, 0.1), swing(0.0, 1.5, -1.5);
-  const Vec3 va = drift + spin.cross(ca - com), vb = drift + spin.cross(cb - com);
-  const Vec3 wa = spin, wb = ab.transpose() * (spin + swing);
-  return R"({
-    "materials": {"steel": {"E": 2.1e11, "G": 8.1e10}},
-    "sections": {"rod": {"shape": "circle", "diameter": 0.005}},
-    "bodies": [
-      {"name": "a", "mass": 1.0, "inertia": [0.01, 0.02, 0.03], "position": )" +
-         vec(ca) + R"(, "velocity": )" + vec(va) + R"(, "angular_velocity": )" + vec(wa) + R"(},
-      {"name": "b", "mass": 2.0, "inertia": [0.02, 0.015, 0.025], "position": )" +
-         vec(cb) + R"(, "orientation": [)" + std::to_string(qb(0)) + ", " + std::to_string(qb(1)) +
-         ", " + std::to_string(qb(2)) + ", " + std::to_string(qb(3)) + R"(], "velocity": )" +
-         vec(vb) + R"(, "angular_velocity": )" + vec(wb) + R"(}],
-    "beams": [{"name": "ab", "body1": "a", "body2": "b", "point1": [0.1, 0, 0],
-               "point2": [0.4, 0.05, -0.03], "point3": [0.1, 1, 0.2], "material": "steel",
-               "section": "rod", "formulation": ")" +
-         formulation + R"("}]})";
-}
+using testing::tumbling_pair_scene;
 
 struct Momenta {
   Vec3 com, v_com, h;  // centre of mass, its velocity, angular momentum about it
@@ -71,7 +40,7 @@ Momenta momenta(const Model& model, const Snapshot& s) {
 
 TEST(Conservation, TumblingPairConservesEnergyAndMomenta) {
   for (const std::string formulation : {"energy", "paper"}) {
-    const Model model = testing::scene_from_json(tumbling_pair(formulation));
+    const Model model = testing::scene_from_json(tumbling_pair_scene(formulation));
     const TransientRun run = testing::simulate(model, testing::options(1.0, 1e-3, 1e-11, 1e-13));
     ASSERT_TRUE(run.result.ok) << run.result.message;
     const Momenta m0 = momenta(model, run.samples.front());

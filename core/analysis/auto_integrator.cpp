@@ -51,7 +51,8 @@ class AutoIntegrator : public Integrator {
     sunctx_ = sunctx;
     const Model& model = c.model;
     if (model.n_free() == 0)
-      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the scene has no free body", error);
+      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the scene has no free body",
+                            error);
     if (model.n_dofs > kModalIntegratorMaxDofs && !(o.max_frequency_hz > 0.0))
       return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
                             std::to_string(model.n_free()) +
@@ -71,7 +72,8 @@ class AutoIntegrator : public Integrator {
         *error = why;
         return false;
       }
-      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the modal method could not start: " + why, error);
+      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
+                            "the modal method could not start: " + why, error);
     }
     std::string reason = std::to_string(model.n_free()) + " free bod" +
                          (model.n_free() == 1 ? "y" : "ies") +

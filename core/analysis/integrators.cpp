@@ -220,8 +220,10 @@ class Cvode : public SundialsIntegrator {
     // |q| = 1 by projection (CVODE projects for BDF only; Adams states are renormalized when
     // the analysis restarts and the rotation uses q/|q| throughout).
     if (o.method == IntegratorMethod::kBdf) CVodeSetProjFn(mem_, ode_project);
-    CVodeSetMaxOrd(mem_, o.method == IntegratorMethod::kAdams ? std::min(12, o.max_order) : o.max_order);
-    if (o.stability_limit_detection && o.method == IntegratorMethod::kBdf) CVodeSetStabLimDet(mem_, SUNTRUE);
+    CVodeSetMaxOrd(mem_,
+                   o.method == IntegratorMethod::kAdams ? std::min(12, o.max_order) : o.max_order);
+    if (o.stability_limit_detection && o.method == IntegratorMethod::kBdf)
+      CVodeSetStabLimDet(mem_, SUNTRUE);
     if (o.max_step > 0.0) CVodeSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) CVodeSetInitStep(mem_, o.initial_step);
     return true;

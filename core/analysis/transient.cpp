@@ -58,9 +58,9 @@ const char* method_name(IntegratorMethod method) {
 }
 
 std::optional<IntegratorMethod> method_from_name(const std::string& name) {
-  for (IntegratorMethod m : {IntegratorMethod::kBdf, IntegratorMethod::kAdams,
-                             IntegratorMethod::kDirk, IntegratorMethod::kErk,
-                             IntegratorMethod::kModal, IntegratorMethod::kAuto})
+  for (IntegratorMethod m :
+       {IntegratorMethod::kBdf, IntegratorMethod::kAdams, IntegratorMethod::kDirk,
+        IntegratorMethod::kErk, IntegratorMethod::kModal, IntegratorMethod::kAuto})
     if (name == method_name(m)) return m;
   return std::nullopt;
 }

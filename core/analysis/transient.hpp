@@ -40,9 +40,9 @@ struct IntegratorOptions {
   // bdf | adams (CVODE), dirk | erk (ARKODE), modal, auto (core/analysis/auto_integrator.hpp).
   // A study's transient defaults to auto (optimizer/study/analysis_specs.cpp); this struct to bdf.
   IntegratorMethod method = IntegratorMethod::kBdf;
-  std::string table;           // dirk/erk: ARKODE Butcher table name ("" = default)
-  double rtol = 1e-6;          // relative tolerance
-  double atol = 1e-9;          // absolute tolerance (states in m, -, m/s, rad/s)
+  std::string table;   // dirk/erk: ARKODE Butcher table name ("" = default)
+  double rtol = 1e-6;  // relative tolerance
+  double atol = 1e-9;  // absolute tolerance (states in m, -, m/s, rad/s)
   JacobianKind jacobian = JacobianKind::kExact;
   LinearSolverKind linear_solver = LinearSolverKind::kAuto;
   int max_order = 5;                       // BDF order limit 1..5 (Adams: 1..12)

@@ -201,7 +201,7 @@ std::optional<std::vector<double>> ObjectReader::numbers(const std::string& key,
   bool ok = true;
   for (size_t i = 0; i < v->size(); ++i) {
     const auto x = plain_number((*v)[i]) ? std::optional<double>((*v)[i].get<double>())
-                                          : read_number((*v)[i], at(key) / i, diag_);
+                                         : read_number((*v)[i], at(key) / i, diag_);
     ok = ok && x.has_value();
     out.push_back(x.value_or(0.0));
   }

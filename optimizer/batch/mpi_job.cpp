@@ -6,6 +6,7 @@
 
 #ifdef BEAMRAIL_MPI
 #include <mpi.h>
+#include <time.h>
 
 #include <atomic>
 #include <chrono>
@@ -17,8 +18,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <time.h>
 
 #include "core/analysis/stop_request.hpp"
 #endif
@@ -210,7 +209,8 @@ class MpiExecutor : public BatchExecutor {
     std::vector<std::thread> pool;
     for (int t = 0; t < threads_; ++t)
       pool.emplace_back([&] {
-        for (long i = take(); i >= 0; i = take()) deliver(0, i, evaluate_design(evaluator, designs[i]));
+        for (long i = take(); i >= 0; i = take())
+          deliver(0, i, evaluate_design(evaluator, designs[i]));
       });
 
     std::vector<int> ahead(size, 0);
@@ -267,8 +267,8 @@ class MpiExecutor : public BatchExecutor {
 
 MpiJob::MpiJob(int* argc, char*** argv) {
   current_job = this;
-  const bool launched = std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") ||
-                        std::getenv("PMI_RANK");
+  const bool launched =
+      std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK");
   if (!launched) return;
   int provided = 0;
   MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
@@ -294,8 +294,8 @@ int MpiJob::serve() {
   std::unique_ptr<Study> study;
   std::unique_ptr<DesignEvaluator> evaluator;
   std::string unusable;  // why the study sent could not be loaded (then every design fails)
-  std::deque<std::pair<long, Design>> work;
-  std::vector<std::vector<char>> results;
+  std::deque<std::pair<long, Design> > work;
+  std::vector<std::vector<char> > results;
   std::mutex mutex;
   std::condition_variable work_ready, result_ready;
   bool quit = false;
@@ -324,7 +324,7 @@ int MpiJob::serve() {
 
   Backoff backoff(std::chrono::microseconds(1000));
   while (true) {
-    std::vector<std::vector<char>> outgoing;
+    std::vector<std::vector<char> > outgoing;
     {
       std::unique_lock<std::mutex> lock(mutex);
       outgoing.swap(results);
@@ -352,8 +352,9 @@ int MpiJob::serve() {
           study = std::make_unique<Study>(std::move(*loaded));
           evaluator = std::make_unique<DesignEvaluator>(*study);
         } else if (unusable.empty()) {
-          unusable = diag.items().empty() ? "no design study"
-                                          : diag.items()[0].pointer + ": " + diag.items()[0].message;
+          unusable = diag.items().empty()
+                         ? "no design study"
+                         : diag.items()[0].pointer + ": " + diag.items()[0].message;
         }
         for (int t = 0; t < std::max(1, threads); ++t) pool.emplace_back(evaluate_work);
       } else if (probed.MPI_TAG == kTagWork) {

@@ -16,15 +16,15 @@
 #include <set>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/output/batch_table.hpp"
-#include "optimizer/run/designs.hpp"
-#include "optimizer/cli/interruption.hpp"
 #include "optimizer/batch/nlopt_setup.hpp"
 #include "optimizer/batch/progress.hpp"
 #include "optimizer/batch/sampling.hpp"
+#include "optimizer/cli/interruption.hpp"
+#include "optimizer/output/batch_table.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/designs.hpp"
 
 namespace beamrail {
 namespace {
@@ -729,7 +729,8 @@ int Optimization::report(const Record* best, const std::vector<Start>& starts, d
     status = "infeasible";
     message = "no evaluated design satisfies every constraint";
     long warned = 0;
-    for (const Record& r : records_) warned += r.outcome.status == Status::kOk && r.outcome.warnings > 0;
+    for (const Record& r : records_)
+      warned += r.outcome.status == Status::kOk && r.outcome.warnings > 0;
     if (warned > 0 && plan_.warned_designs == OptimizePlan::WarnedDesigns::kInfeasible)
       message += " (" + std::to_string(warned) +
                  " designs with warnings count as infeasible; their warnings are in the message "

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <iostream>
 
-#include "optimizer/run/designs.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/designs.hpp"
 
 namespace beamrail {
 namespace {

@@ -7,14 +7,14 @@
 
 #include "core/analysis/stop_request.hpp"
 #include "optimizer/batch/executor.hpp"
-#include "optimizer/output/batch_table.hpp"
-#include "optimizer/run/designs.hpp"
-#include "optimizer/cli/interruption.hpp"
 #include "optimizer/batch/progress.hpp"
 #include "optimizer/batch/sampling.hpp"
+#include "optimizer/cli/interruption.hpp"
+#include "optimizer/output/batch_table.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/designs.hpp"
 
 namespace beamrail {
 
@@ -134,13 +134,13 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   }
   if (interrupted) {
     std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
-              << finished << " of " << designs.size() << " designs are in "
-              << samples.string() << "; continue with: " << settings.command << " --resume\n";
+              << finished << " of " << designs.size() << " designs are in " << samples.string()
+              << "; continue with: " << settings.command << " --resume\n";
     return interrupted_exit_status(signal);
   }
   std::cout << study.name << ": " << designs.size() << " designs (" << failed
-            << " failed or invalid, " << with_warnings << " with warnings) in " << wall
-            << " s -> " << settings.output.string() << "\n";
+            << " failed or invalid, " << with_warnings << " with warnings) in " << wall << " s -> "
+            << settings.output.string() << "\n";
   return 0;
 }
 

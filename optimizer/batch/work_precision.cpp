@@ -8,8 +8,8 @@
 #include "optimizer/cli/interruption.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
-#include "optimizer/run/trajectory.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/trajectory.hpp"
 
 namespace beamrail {
 namespace {

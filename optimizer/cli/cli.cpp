@@ -1,7 +1,5 @@
 #include "optimizer/cli/cli.hpp"
 
-#include "optimizer/batch/mpi_job.hpp"
-
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -9,20 +7,21 @@
 #include <new>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/run/evaluation.hpp"
-#include "optimizer/cli/interruption.hpp"
+#include "optimizer/batch/mpi_job.hpp"
 #include "optimizer/batch/optimize.hpp"
-#include "optimizer/output/output_folder.hpp"
 #include "optimizer/batch/run_settings.hpp"
 #include "optimizer/batch/sensitivity_study.hpp"
-#include "optimizer/study/study.hpp"
-#include "optimizer/output/summary.hpp"
 #include "optimizer/batch/sweep.hpp"
+#include "optimizer/batch/work_precision.hpp"
+#include "optimizer/cli/interruption.hpp"
+#include "optimizer/output/output_folder.hpp"
+#include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
 #include "optimizer/output/vtk_design.hpp"
 #include "optimizer/output/vtk_output.hpp"
-#include "optimizer/batch/work_precision.hpp"
+#include "optimizer/run/evaluation.hpp"
+#include "optimizer/study/study.hpp"
 
 namespace beamrail {
 namespace {

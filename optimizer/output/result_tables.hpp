@@ -54,8 +54,9 @@ bool write_static_tables(const std::filesystem::path& directory, const std::stri
 bool write_modal_tables(const std::filesystem::path& directory, const std::string& prefix,
                         const Model& model, const ModalResult& result, std::string* error);
 
-// buckling.csv (mode, factor, nonlinearity: BucklingMode::nonlinearity) and buckling_shapes.csv (mode, body, dx .. rz: the shape with its
-// largest translation, or rotation times the characteristic length, 1).
+// buckling.csv (mode, factor, nonlinearity: BucklingMode::nonlinearity) and buckling_shapes.csv
+// (mode, body, dx .. rz: the shape with its largest translation, or rotation times the
+// characteristic length, 1).
 bool write_buckling_tables(const std::filesystem::path& directory, const std::string& prefix,
                            const Model& model, const BucklingResult& result, std::string* error);
 

@@ -5,11 +5,11 @@
 #include <iostream>
 #include <sstream>
 
-#include "optimizer/output/batch_table.hpp"
-#include "optimizer/run/evaluation.hpp"
 #include "optimizer/batch/sampling.hpp"
+#include "optimizer/output/batch_table.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/vtk_output.hpp"
+#include "optimizer/run/evaluation.hpp"
 
 namespace beamrail {
 

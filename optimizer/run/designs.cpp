@@ -3,8 +3,8 @@
 #include <chrono>
 #include <limits>
 
-#include "optimizer/run/evaluation.hpp"
 #include "optimizer/output/tables.hpp"
+#include "optimizer/run/evaluation.hpp"
 
 namespace beamrail {
 

@@ -8,12 +8,12 @@
 #include <memory>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/run/expressions.hpp"
-#include "optimizer/run/responses.hpp"
 #include "optimizer/output/result_tables.hpp"
 #include "optimizer/output/tables.hpp"
-#include "optimizer/run/trajectory.hpp"
 #include "optimizer/output/vtk_output.hpp"
+#include "optimizer/run/expressions.hpp"
+#include "optimizer/run/responses.hpp"
+#include "optimizer/run/trajectory.hpp"
 
 namespace beamrail {
 namespace {

@@ -9,8 +9,8 @@
 #include <map>
 #include <mutex>
 
-#include "optimizer/study/study.hpp"
 #include "optimizer/output/tables.hpp"
+#include "optimizer/study/study.hpp"
 
 namespace beamrail {
 namespace {

@@ -36,8 +36,8 @@ inline const char* status_name(Status status) {
 
 // The status named `name` (a table read back), nullopt for any other text.
 inline std::optional<Status> status_from_name(const std::string& name) {
-  for (Status s : {Status::kOk, Status::kFailed, Status::kTimeout, Status::kInvalid,
-                   Status::kInterrupted})
+  for (Status s :
+       {Status::kOk, Status::kFailed, Status::kTimeout, Status::kInvalid, Status::kInterrupted})
     if (name == status_name(s)) return s;
   return std::nullopt;
 }

@@ -42,12 +42,14 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
     if (io.method != IntegratorMethod::kBdf && io.method != IntegratorMethod::kAdams)
       r.error("max_order", "applies to the \"bdf\" and \"adams\" methods");
     else if (*q > limit)
-      r.error("max_order", std::string(method_name(io.method)) + " orders go from 1 to " + std::to_string(limit));
+      r.error("max_order", std::string(method_name(io.method)) + " orders go from 1 to " +
+                               std::to_string(limit));
     else
       io.max_order = static_cast<int>(*q);
   }
   if (const auto d = r.boolean("stability_limit_detection", false)) {
-    if (io.method != IntegratorMethod::kBdf) r.error("stability_limit_detection", "applies to the \"bdf\" method");
+    if (io.method != IntegratorMethod::kBdf)
+      r.error("stability_limit_detection", "applies to the \"bdf\" method");
     io.stability_limit_detection = *d;
   }
   io.max_step = r.positive("max_step", false).value_or(0.0);
@@ -75,7 +77,8 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
   const size_t problems_before = r.diagnostics().items().size();
   const auto t_end = r.positive("t_end", true);
   const auto step = r.positive("output_step", false);
-  a.transient.integrator.method = IntegratorMethod::kAuto;  // the study file's default (docs/study_files.md)
+  a.transient.integrator.method =
+      IntegratorMethod::kAuto;  // the study file's default (docs/study_files.md)
   if (const Json* i = r.member("integrator", false))
     read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
   a.verify = r.boolean("verify", false).value_or(false);
@@ -92,7 +95,8 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
       band = r.positive("max_frequency_hz", false).value_or(-1.0);
     }
     const IntegratorOptions& io = a.transient.integrator;
-    if (band >= 0.0 && io.method != IntegratorMethod::kModal && io.method != IntegratorMethod::kAuto) {
+    if (band >= 0.0 && io.method != IntegratorMethod::kModal &&
+        io.method != IntegratorMethod::kAuto) {
       r.error("max_frequency_hz", "applies to the \"modal\" and \"auto\" methods");
       band = -1.0;
     }
@@ -264,8 +268,8 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   // What the analysis itself refuses, once the reader's checks, which name the key at fault, pass
   // (a transient's options are checked in read_transient).
   std::string problem;
-  const bool valid = a.type == AnalysisSpec::Type::kStatic   ? a.statics.IsValid(&problem)
-                     : a.type == AnalysisSpec::Type::kModal  ? a.modal.IsValid(&problem)
+  const bool valid = a.type == AnalysisSpec::Type::kStatic     ? a.statics.IsValid(&problem)
+                     : a.type == AnalysisSpec::Type::kModal    ? a.modal.IsValid(&problem)
                      : a.type == AnalysisSpec::Type::kBuckling ? a.buckling.IsValid(&problem)
                                                                : true;
   if (ok && !valid) {

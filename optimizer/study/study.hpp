@@ -102,7 +102,8 @@ struct Study {
   std::vector<ResponseSpec> responses;
   std::vector<int> expression_order;  // the expression responses, each after those it reads
   std::optional<DesignStudy> design;  // without it the analyses run once
-  // "outputs": {"vtk": true}: the run writes VTK files (optimizer/output/vtk_output.hpp), as --vtk does.
+  // "outputs": {"vtk": true}: the run writes VTK files (optimizer/output/vtk_output.hpp), as --vtk
+  // does.
   bool vtk = false;
   // What in the study file looks mistyped but may be meant ("file:/pointer: message"): printed
   // by `check` and `run`, and listed among the warnings of summary.json.

@@ -54,7 +54,8 @@ TEST_F(BatchTableTest, RowsFromManyThreadsEndSortedByTheirKeysEachOnce) {
     pool.emplace_back([&, t] {
       for (int k = 0; k < per_thread; ++k) {
         const int i = k * threads + t;
-        EXPECT_TRUE(table.append({std::to_string(i % 3), std::to_string(-i), "a, \"quoted\" note"}));
+        EXPECT_TRUE(
+            table.append({std::to_string(i % 3), std::to_string(-i), "a, \"quoted\" note"}));
       }
     });
   for (std::thread& t : pool) t.join();
@@ -80,8 +81,7 @@ TEST_F(BatchTableTest, AResumedTableGivesBackItsWholeRowsAndDropsAnUnfinishedLin
   BatchTable table;
   std::vector<CsvRow> existing;
   std::string error;
-  ASSERT_EQ(table.open(path, {"index", "value"}, true, &existing, &error),
-            BatchTable::Opened::kOk)
+  ASSERT_EQ(table.open(path, {"index", "value"}, true, &existing, &error), BatchTable::Opened::kOk)
       << error;
   ASSERT_EQ(existing.size(), 2u);
   EXPECT_EQ(existing[0], (CsvRow{"2", "0.5"}));

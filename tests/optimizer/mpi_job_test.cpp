@@ -131,8 +131,7 @@ class MpiRun : public ::testing::Test {
   // mpirun's arguments for `ranks` ranks of `beamrail args...`: more ranks than cores are
   // allowed, threads are not bound to one core, and root may run it (CI runs as root).
   static std::vector<std::string> mpirun_args(int ranks, const std::vector<std::string>& args) {
-    std::vector<std::string> a{"--oversubscribe", "--bind-to", "none", "-n",
-                               std::to_string(ranks)};
+    std::vector<std::string> a{"--oversubscribe", "--bind-to", "none", "-n", std::to_string(ranks)};
     if (geteuid() == 0) a.insert(a.begin(), "--allow-run-as-root");
     a.push_back(BEAMRAIL_EXECUTABLE);
     a.insert(a.end(), args.begin(), args.end());
@@ -151,10 +150,11 @@ class MpiRun : public ::testing::Test {
   // compares the tables.
   void expect_same_tables(const Json& study, int ranks, int threads) {
     const fs::path file = write_study("study.json", study);
-    const ProcessResult alone = run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
+    const ProcessResult alone =
+        run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
     ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
-    const ProcessResult mpi = run_mpi(ranks, {"run", file.string(), "-o", "mpi", "-j",
-                                              std::to_string(threads), "--quiet"});
+    const ProcessResult mpi = run_mpi(
+        ranks, {"run", file.string(), "-o", "mpi", "-j", std::to_string(threads), "--quiet"});
     ASSERT_TRUE(mpi.exited && mpi.status == 0) << mpi.how << "\n" << mpi.out << mpi.err;
     const auto expected = rows_without_wall(dir_ / "alone" / "samples.csv");
     const auto got = rows_without_wall(dir_ / "mpi" / "samples.csv");

@@ -43,7 +43,8 @@ TEST(Sampling, ALatinHypercubeHasOnePointInEveryStratumOfEveryVariable) {
     for (const Design& x : d) {
       ASSERT_GE(x[j], v[j].lower);
       ASSERT_LT(x[j], v[j].upper);
-      strata.insert(static_cast<int>(std::floor((x[j] - v[j].lower) / (v[j].upper - v[j].lower) * n)));
+      strata.insert(
+          static_cast<int>(std::floor((x[j] - v[j].lower) / (v[j].upper - v[j].lower) * n)));
     }
     EXPECT_EQ(strata.size(), static_cast<size_t>(n)) << "variable " << j;
   }

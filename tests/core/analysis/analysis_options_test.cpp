@@ -61,10 +61,12 @@ TEST(AnalysisOptions, StaticModalAndBucklingRefuseOptionsThatCannotRun) {
   const std::function<ModalResult(const ModalOptions&)> modal = [&](const ModalOptions& o) {
     return solve_modal(model, o, data);
   };
-  expect_refused<ModalOptions, ModalResult>("modes", [](ModalOptions& o) { o.modes = 0; }, modal);
+  expect_refused<ModalOptions, ModalResult>(
+      "modes", [](ModalOptions& o) { o.modes = 0; }, modal);
   expect_refused<ModalOptions, ModalResult>(
       "load_factor", [](ModalOptions& o) { o.load_factor = INFINITY; }, modal);
-  expect_refused<ModalOptions, ModalResult>("time", [](ModalOptions& o) { o.time = NAN; }, modal);
+  expect_refused<ModalOptions, ModalResult>(
+      "time", [](ModalOptions& o) { o.time = NAN; }, modal);
   const std::function<BucklingResult(const BucklingOptions&)> buckling =
       [&](const BucklingOptions& o) { return solve_buckling(model, model, o, data); };
   expect_refused<BucklingOptions, BucklingResult>(

@@ -117,11 +117,11 @@ TEST(NonConservativeLoads, TipTorqueModesAreThoseOfTheNonSymmetricProblem) {
 // stable equilibrium: the static analysis reports it ok with the exact tip rotation, the modal
 // analysis finds real positive eigenvalues, and a transient that ramps the torque on under a
 // constant 0.01 N out-of-plane force does not grow once the torque is on: its largest
-// out-of-plane deflection over the last 2 s is within 10 % of that over the 2 s before. (Its symmetric
-// part has a negative eigenvalue: that test called it unstable.) The circle's static out-of-plane
-// deflection converges at second order (10 to 160 segments: 1.2358e-5 to 1.2440e-5 m), to where
-// the paper law converges at first order; with the atan2 angles the energy law gave 2.3e-5 m at
-// 10 segments, and the transient stayed within twice that.
+// out-of-plane deflection over the last 2 s is within 10 % of that over the 2 s before. (Its
+// symmetric part has a negative eigenvalue: that test called it unstable.) The circle's static
+// out-of-plane deflection converges at second order (10 to 160 segments: 1.2358e-5 to 1.2440e-5 m),
+// to where the paper law converges at first order; with the atan2 angles the energy law gave 2.3e-5
+// m at 10 segments, and the transient stayed within twice that.
 TEST(NonConservativeLoads, BeamBentIntoACircleByATipTorqueIsStable) {
   const double ei = kE * std::pow(0.01, 4) / 12;
   Scene s = bent_cantilever(2 * ei, 10);

@@ -5,8 +5,8 @@
 // run as interrupted with the samples delivered so far.
 #include <gtest/gtest.h>
 
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <functional>
 #include <string>
 #include <vector>

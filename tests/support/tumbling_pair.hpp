@@ -1,6 +1,7 @@
-// A rotating scene for the transient tests: two bodies joined by a 5 mm steel rod, tumbling together
-// (spinning at ~2.7 rad/s about their common centre of mass) while body b also swings relative to
-// a, so the rod bends and twists by a few hundredths of a radian. The rod's law: `formulation`.
+// A rotating scene for the transient tests: two bodies joined by a 5 mm steel rod, tumbling
+// together (spinning at ~2.7 rad/s about their common centre of mass) while body b also swings
+// relative to a, so the rod bends and twists by a few hundredths of a radian. The rod's law:
+// `formulation`.
 #pragma once
 
 #include <cstdio>

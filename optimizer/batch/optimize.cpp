@@ -895,17 +895,10 @@ int Optimization::run() {
   }
   std::vector<CsvRow> existing;
   std::string error;
-  switch (history_.open(settings_.output / "history.csv", header, settings_.resume, &existing,
-                        &error)) {
-    case BatchTable::Opened::kOk:
-      break;
-    case BatchTable::Opened::kOtherColumns:
-      std::cerr << "beamrail: " << error << "\n";
-      return 2;
-    case BatchTable::Opened::kWriteError:
-      std::cerr << "beamrail: " << error << "\n";
-      return 1;
-  }
+  if (const int status = open_exit_status(history_.open(settings_.output / "history.csv", header,
+                                                        settings_.resume, &existing, &error),
+                                          error))
+    return status;
   // Earlier evaluations become the cache that NLopt's replayed path hits.
   const size_t nv = variables_.size(), nr = study_.responses.size();
   for (const CsvRow& r : existing) {
@@ -929,17 +922,11 @@ int Optimization::run() {
       for (const DesignVariable& v : variables_)
         columns.push_back("d " + r.name + " / d " + v.name);
     std::vector<CsvRow> rows;
-    switch (derivatives_.open(settings_.output / "derivatives.csv", columns, settings_.resume,
-                              &rows, &error)) {
-      case BatchTable::Opened::kOk:
-        break;
-      case BatchTable::Opened::kOtherColumns:
-        std::cerr << "beamrail: " << error << "\n";
-        return 2;
-      case BatchTable::Opened::kWriteError:
-        std::cerr << "beamrail: " << error << "\n";
-        return 1;
-    }
+    if (const int status =
+            open_exit_status(derivatives_.open(settings_.output / "derivatives.csv", columns,
+                                               settings_.resume, &rows, &error),
+                             error))
+      return status;
     for (const CsvRow& r : rows) {
       Design x;
       for (size_t i = 0; i < nv; ++i) x.push_back(std::strtod(r[i].c_str(), nullptr));

@@ -36,16 +36,9 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   BatchTable table;
   std::vector<CsvRow> existing;
   std::string error;
-  switch (table.open(samples, header, settings.resume, &existing, &error)) {
-    case BatchTable::Opened::kOk:
-      break;
-    case BatchTable::Opened::kOtherColumns:
-      std::cerr << "beamrail: " << error << "\n";
-      return 2;
-    case BatchTable::Opened::kWriteError:
-      std::cerr << "beamrail: " << error << "\n";
-      return 1;
-  }
+  if (const int status =
+          open_exit_status(table.open(samples, header, settings.resume, &existing, &error), error))
+    return status;
   std::set<long> done;
   long failures = 0, warned = 0;
   for (const CsvRow& row : existing) {

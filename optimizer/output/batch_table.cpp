@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <sstream>
 
@@ -23,19 +24,6 @@ std::string join(const CsvRow& row) {
     line += csv_field(row[i]);
   }
   return line + '\n';
-}
-
-bool write_all(int fd, const std::string& text) {
-  size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    done += static_cast<size_t>(n);
-  }
-  return true;
 }
 
 // Reads the whole lines of a file; the byte length of those lines goes to *whole_bytes.
@@ -162,6 +150,20 @@ bool BatchTable::finalize(const std::vector<int>& key_columns, std::string* erro
   std::string text = join(header_);
   for (const auto& [key, row] : rows) text += join(row);
   return write_file_atomically(path_, text, error);
+}
+
+int open_exit_status(BatchTable::Opened opened, const std::string& error) {
+  switch (opened) {
+    case BatchTable::Opened::kOk:
+      return 0;
+    case BatchTable::Opened::kOtherColumns:
+      std::cerr << "beamrail: " << error << "\n";
+      return 2;
+    case BatchTable::Opened::kWriteError:
+      break;
+  }
+  std::cerr << "beamrail: " << error << "\n";
+  return 1;
 }
 
 }  // namespace beamrail

@@ -9,7 +9,6 @@
 #include <cstring>
 
 namespace beamrail {
-namespace {
 
 bool write_all(int fd, const std::string& text) {
   size_t done = 0;
@@ -23,8 +22,6 @@ bool write_all(int fd, const std::string& text) {
   }
   return true;
 }
-
-}  // namespace
 
 std::string format_number(double x) {
   if (std::isnan(x)) return "nan";

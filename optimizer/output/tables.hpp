@@ -12,6 +12,10 @@ namespace beamrail {
 // Shortest text that reads back as exactly x ("nan", "inf", "-inf" for non-finite values).
 std::string format_number(double x);
 
+// Writes all of text to the file descriptor, retrying short and interrupted writes; false on an
+// error (errno says which).
+bool write_all(int fd, const std::string& text);
+
 // A CSV table appended one whole row at a time. Rows are buffered and handed to the operating
 // system in single write calls that end at a row boundary, so a killed process leaves whole rows;
 // after a write error (disk full, file-size limit) the rows written in part are cut off again, the

@@ -109,13 +109,25 @@ struct BlockPattern {
   std::vector<int> transposed;  // per block, the index of the block (col, row)
 };
 
+// How many segments "segments": "auto" gave a beam, and why (core/scene/auto_segments.hpp).
+struct SegmentChoice {
+  std::string beam;               // the scene beam's name
+  long segments = 0;              // the count used
+  double first_frequency_hz = 0;  // the beam's first clamped-free bending frequency at that count
+  double estimated_error = 0;     // the largest estimated relative error of the checked ones
+  int frequencies_checked = 0;    // per bending plane, the most frequencies checked
+  bool reached = true;            // false: the largest count missed the target
+  bool pinned = false;            // true: the count of the study's scene, kept for this design
+};
+
 struct Model {
   std::vector<Body> bodies;  // [0] is ground
   std::vector<Beam> beams;
   std::vector<Rail> rails;
   std::vector<Load> loads;
-  Vec3 gravity = Vec3::Zero();          // [m/s^2]
-  std::vector<std::string> load_cases;  // the names loads give as their case, in scene order
+  Vec3 gravity = Vec3::Zero();                 // [m/s^2]
+  std::vector<std::string> load_cases;         // the names loads give as their case, in scene order
+  std::vector<SegmentChoice> segment_choices;  // of the beams with "segments": "auto"
 
   std::vector<int> free_bodies;  // body index of each free body, in state order
   int n_states = 0;              // 13 per free body: c(3), q(4), v(3), w(3)
@@ -142,6 +154,7 @@ Model with_loads(const Model& model, Keep&& keep, bool gravity) {
     if (keep(load)) out.loads.push_back(load);
   out.gravity = gravity ? model.gravity : Vec3::Zero();
   out.load_cases = model.load_cases;
+  out.segment_choices = model.segment_choices;
   out.free_bodies = model.free_bodies;
   out.n_states = model.n_states;
   out.n_dofs = model.n_dofs;

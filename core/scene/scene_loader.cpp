@@ -2,11 +2,15 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <set>
 #include <string>
 
 #include "core/model/rotation.hpp"
+#include "core/scene/auto_segments.hpp"
 #include "core/scene/scene_specs.hpp"
 
 namespace beamrail {
@@ -165,15 +169,87 @@ ElementEnds make_ends(const ElementSpec& e, const std::vector<Body>& bodies) {
   return ends;
 }
 
+// The scene's "segmentation" object: what "segments": "auto" aims at.
+SegmentationTarget read_segmentation(const Json& value, const Where& where, Diagnostics& diag) {
+  SegmentationTarget target;
+  ObjectReader r(value, where, diag);
+  if (!r.is_object()) return target;
+  if (const auto e = r.positive("frequency_error", false)) {
+    if (*e < 1.0)
+      target.frequency_error = *e;
+    else
+      r.error("frequency_error", "must be < 1 (a relative error: 1e-3 is 0.1 %)");
+  }
+  target.max_frequency_hz = r.positive("max_frequency_hz", false).value_or(0.0);
+  return target;
+}
+
+// Sets the segment count of every beam with "segments": "auto" (pinned: the counts of the study's
+// scene, kept by the designs built from it) and records the choices.
+void choose_auto_segments(SceneSpecs& specs, const SegmentationTarget& target,
+                          const std::vector<SegmentChoice>* pinned, Diagnostics& diag,
+                          std::vector<SegmentChoice>& choices) {
+  std::map<std::array<double, 6>, SegmentChoice> by_beam;  // identical members choose once
+  for (ElementSpec& e : specs.elements) {
+    if (!e.auto_segments) continue;
+    SegmentChoice c;
+    const auto kept = pinned
+                          ? std::find_if(pinned->begin(), pinned->end(),
+                                         [&](const SegmentChoice& p) { return p.beam == e.name; })
+                          : std::vector<SegmentChoice>::const_iterator();
+    if (pinned && kept != pinned->end()) {
+      c = *kept;
+      c.pinned = true;
+    } else {
+      const double rho = e.material.density;
+      UniformBeam b;
+      b.length = (e.p2 - e.p1).norm();
+      b.ei[0] = e.material.e * e.section.iy, b.ei[1] = e.material.e * e.section.iz;
+      b.rho_i[0] = rho * e.section.iy, b.rho_i[1] = rho * e.section.iz;
+      b.rho_area = rho * e.section.area;
+      const std::array<double, 6> key{b.length,   b.ei[0],    b.ei[1],
+                                      b.rho_i[0], b.rho_i[1], b.rho_area};
+      auto it = by_beam.find(key);
+      if (it == by_beam.end()) it = by_beam.emplace(key, choose_segments(e.name, b, target)).first;
+      c = it->second;
+      c.beam = e.name;
+      if (!c.reached) {
+        char text[240];
+        std::snprintf(text, sizeof text,
+                      "beam \"%s\": %ld segments (the most \"auto\" gives) reach an estimated "
+                      "bending-frequency error of %.2g, above the target %.2g",
+                      e.name.c_str(), c.segments, c.estimated_error, target.frequency_error);
+        diag.warning(e.where.file, (e.where / "segments").pointer, text);
+      }
+    }
+    if (specs.n_segments + c.segments > kMaxSegments) {
+      diag.error(e.where.file, (e.where / "segments").pointer,
+                 "\"auto\" gives " + std::to_string(c.segments) + " segments: more than " +
+                     std::to_string(kMaxSegments) + " in the scene, all beams together");
+      return;
+    }
+    specs.n_segments += c.segments;
+    e.segments = c.segments;
+    choices.push_back(c);
+  }
+}
+
 }  // namespace
 
-std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnostics& diag) {
+std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnostics& diag,
+                                const std::vector<SegmentChoice>* pinned) {
   const size_t errors_before = diag.size();
   SceneSpecs specs;
+  SegmentationTarget target;
+  bool target_given = false;
   {
     ObjectReader r(scene, where, diag);
     if (!r.is_object()) return std::nullopt;
     specs.gravity = r.vec3("gravity", false).value_or(Vec3::Zero());
+    if (const Json* seg = r.member("segmentation", false)) {
+      target = read_segmentation(*seg, r.at("segmentation"), diag);
+      target_given = true;
+    }
     read_materials(r, specs);
     read_sections(r, specs);
     read_bodies(r, specs);
@@ -182,6 +258,12 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     read_loads(r, specs);
   }
   if (diag.size() > errors_before) return std::nullopt;
+  std::vector<SegmentChoice> choices;
+  choose_auto_segments(specs, target, pinned, diag, choices);
+  if (diag.size() > errors_before) return std::nullopt;
+  if (target_given && choices.empty())
+    diag.warning(where.file, (where / "segmentation").pointer,
+                 "no beam has \"segments\": \"auto\": the segmentation target does nothing");
   check_plausibility(specs, where, diag);
 
   std::vector<std::vector<PointMass>> extra(specs.bodies.size());
@@ -308,6 +390,7 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
   if (diag.size() > errors_before) return std::nullopt;
 
   model.load_cases = specs.load_cases;
+  model.segment_choices = std::move(choices);
   model.finalize();
   if (model.n_free() == 0) {
     diag.error(

@@ -340,7 +340,16 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
     e.damping = r.positive("damping", false, true).value_or(0.0);
     const auto form = r.choice("formulation", false, {"energy", "paper"});
     if (form && *form == "paper") e.formulation = Formulation::kPaper;
-    const auto segments = r.integer("segments", false, 0);
+    std::optional<long> segments;
+    if (const Json* m = r.member("segments", false); m && m->is_string()) {
+      if (*m == "auto")
+        e.auto_segments = true;
+      else
+        r.error("segments",
+                "expected an integer >= 0 or \"auto\", got \"" + m->get<std::string>() + "\"");
+    } else {
+      segments = r.integer("segments", false, 0);
+    }
     if (segments && *segments > kMaxSegments) {
       r.error("segments", "at most " + std::to_string(kMaxSegments) + " segments");
       e.segments = 0;
@@ -399,11 +408,11 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
       ok = false;
     }
     if (p1 && p2 && p3 && !element_frame(*p1, *p2, *p3, at, diag)) ok = false;
-    if (rails && e.segments > 0) {
+    if (rails && (e.segments > 0 || e.auto_segments)) {
       r.error("segments", "rails cannot be segmented: the carriage slides along them");
       ok = false;
     }
-    if (ok && e.segments > 0 && specs.materials.at(*material).density <= 0.0) {
+    if (ok && (e.segments > 0 || e.auto_segments) && specs.materials.at(*material).density <= 0.0) {
       r.error("segments", "a segmented beam needs a material with a density > 0");
       ok = false;
     }

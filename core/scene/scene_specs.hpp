@@ -50,7 +50,8 @@ struct ElementSpec {
   std::string material_name, section_name;
   double damping = 0.0;
   Formulation formulation = Formulation::kEnergy;
-  long segments = 0;  // at most kMaxSegments, all elements together
+  long segments = 0;           // at most kMaxSegments, all elements together
+  bool auto_segments = false;  // "segments": "auto": the count is chosen when the scene is built
   std::optional<double> min_length;
   std::optional<std::vector<double>> travel;  // rails: [min, max] of the carriage's coordinate
 };

@@ -141,6 +141,13 @@ int check(const RunArguments& args) {
             << " beams, " << m.rails.size() << " rails, " << m.n_states << " states, "
             << study->analyses.size() << " analyses, " << study->responses.size()
             << " responses)\n";
+  for (const SegmentChoice& c : m.segment_choices) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "  beam \"%s\": %ld segments (auto; estimated bending-frequency error %.2g)\n",
+                  c.beam.c_str(), c.segments, c.estimated_error);
+    std::cout << line;
+  }
   return 0;
 }
 

@@ -32,14 +32,27 @@ int fail_before_designs(const Study& study, const std::filesystem::path& output,
 nlohmann::json model_summary(const Model& model) {
   int generated = 0;
   for (const Body& b : model.bodies) generated += b.generated;
-  return {{"bodies", static_cast<int>(model.bodies.size()) - 1 - generated},
-          {"generated_bodies", generated},
-          {"free_bodies", model.n_free()},
-          {"beams", model.beams.size()},
-          {"rails", model.rails.size()},
-          {"loads", model.loads.size()},
-          {"states", model.n_states},
-          {"degrees_of_freedom", model.n_dofs}};
+  nlohmann::json out{{"bodies", static_cast<int>(model.bodies.size()) - 1 - generated},
+                     {"generated_bodies", generated},
+                     {"free_bodies", model.n_free()},
+                     {"beams", model.beams.size()},
+                     {"rails", model.rails.size()},
+                     {"loads", model.loads.size()},
+                     {"states", model.n_states},
+                     {"degrees_of_freedom", model.n_dofs}};
+  if (!model.segment_choices.empty()) {
+    nlohmann::json chosen = nlohmann::json::array();
+    for (const SegmentChoice& c : model.segment_choices)
+      chosen.push_back({{"beam", c.beam},
+                        {"segments", c.segments},
+                        {"first_bending_frequency_hz", c.first_frequency_hz},
+                        {"estimated_frequency_error", c.estimated_error},
+                        {"frequencies_checked", c.frequencies_checked},
+                        {"target_reached", c.reached},
+                        {"kept_from_study_scene", c.pinned}});
+    out["segments_auto"] = chosen;
+  }
+  return out;
 }
 
 nlohmann::json evaluation_summary(const Study& study, const Model& model, const Evaluation& ev) {

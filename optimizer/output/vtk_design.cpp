@@ -194,7 +194,8 @@ int draw_design(const Study& study, const DesignChoice& choice, const fs::path& 
     design["variables"] = values;
   }
   Diagnostics diag;
-  const std::optional<Study> drawn = load_study(document, study.file, study.directory, diag);
+  const std::optional<Study> drawn =
+      load_study(document, study.file, study.directory, diag, &study.model.segment_choices);
   if (!drawn) {
     std::cerr << "beamrail: no VTK files: " << describe(choice) << " is invalid:\n"
               << diag.format();

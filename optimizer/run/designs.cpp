@@ -108,7 +108,8 @@ std::optional<Study> DesignEvaluator::build(const std::vector<double>& x, Diagno
     if (s || !full) return s;
     diag = Diagnostics();
   }
-  return load_study(document(x), study_.file, study_.directory, diag);
+  return load_study(document(x), study_.file, study_.directory, diag,
+                    &study_.model.segment_choices);
 }
 
 DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,

@@ -86,7 +86,8 @@ void check_load_cases(const Study& study, Diagnostics& diag) {
 }  // namespace
 
 std::optional<Study> load_study(const Json& document, const std::string& file,
-                                const std::filesystem::path& directory, Diagnostics& diag) {
+                                const std::filesystem::path& directory, Diagnostics& diag,
+                                const std::vector<SegmentChoice>* pinned) {
   const size_t errors_before = diag.size(), warnings_before = diag.warnings().size();
   Study study;
   study.file = file;
@@ -144,12 +145,12 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
                        "expected the scene object, got a string (a scene file cannot name "
                        "another scene file)");
           } else {
-            model = load_scene(*j, {shown, ""}, diag);
+            model = load_scene(*j, {shown, ""}, diag, pinned);
             study.document["scene"] = *j;
           }
         }
       } else {
-        model = load_scene(*scene, root / "scene", diag);
+        model = load_scene(*scene, root / "scene", diag, pinned);
       }
     }
 
@@ -230,7 +231,8 @@ std::optional<Study> rebuild_scene(const Study& base, const Json& document, Diag
     return std::nullopt;
   }
   const size_t warnings_before = diag.warning_lines().size();
-  auto model = load_scene(*scene, Where{base.file, ""} / "scene", diag);
+  auto model =
+      load_scene(*scene, Where{base.file, ""} / "scene", diag, &base.model.segment_choices);
   if (!model) return std::nullopt;
   if (!same_structure(*model, base.model)) {
     *full_read_needed = true;

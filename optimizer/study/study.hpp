@@ -115,8 +115,11 @@ std::optional<Study> load_study_file(const std::string& path, Diagnostics& diag)
 
 // Validates and builds a study from a document already in memory (design variables rebuild
 // studies this way). `file` names the source in messages; `directory` resolves relative paths.
+// `pinned`: the segment counts the study's scene chose for "segments": "auto" (a design keeps
+// them; see load_scene).
 std::optional<Study> load_study(const Json& document, const std::string& file,
-                                const std::filesystem::path& directory, Diagnostics& diag);
+                                const std::filesystem::path& directory, Diagnostics& diag,
+                                const std::vector<SegmentChoice>* pinned = nullptr);
 
 // The study `base` with the document `document`, which differs from base.document in numbers of
 // its scene only (a design's values): its scene is built again, the rest (analyses, responses)
@@ -124,7 +127,7 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
 // The result keeps no document (a design's is its evaluator's to give). nullopt when the scene is
 // invalid (its problems in diag) or when the numbers change more than the Model's numbers (its
 // bodies, elements or loads, or whether gravity acts): then load_study must read the whole
-// document (*full_read_needed is set).
+// document (*full_read_needed is set). The beams with "segments": "auto" keep base's counts.
 std::optional<Study> rebuild_scene(const Study& base, const Json& document, Diagnostics& diag,
                                    bool* full_read_needed);
 

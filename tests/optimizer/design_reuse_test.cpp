@@ -208,5 +208,39 @@ TEST(DesignReuse, ValuesThatChangeTheAnalysesDefaultsReadTheWholeStudy) {
   EXPECT_NE(f[0], f[2]);
 }
 
+// "segments": "auto" chooses once, for the study's scene, and every design keeps that count (its
+// responses stay continuous in the variables). With a band of 130 Hz the 1 m cantilever checks
+// its first two bending frequencies (8.4 and 52 Hz; the third is 147 Hz); at 1.1 m the third
+// (121 Hz) enters the band, so that design read on its own chooses more segments (28 instead of
+// 24 at 1e-2) -- the design the evaluator builds keeps the study's.
+TEST(DesignReuse, AutoSegmentCountsAreTheStudysForEveryDesign) {
+  std::string text = kStudy;
+  const std::string fixed = "\"segments\": 6";
+  text.replace(text.find(fixed), fixed.size(), "\"segments\": \"auto\"");
+  text.replace(text.find("\"beams\""), 0,
+               "\"segmentation\": {\"frequency_error\": 1e-2, \"max_frequency_hz\": 130}, ");
+  Diagnostics diag;
+  const auto study = load(diag, text);
+  ASSERT_TRUE(study) << diag.format();
+  ASSERT_EQ(study->model.segment_choices.size(), 1u);
+  const SegmentChoice& own = study->model.segment_choices[0];
+  EXPECT_EQ(own.frequencies_checked, 2);
+  EXPECT_FALSE(own.pinned);
+  const DesignEvaluator evaluator(*study);
+  const std::vector<double> longer{0.01, 1.1};
+  const auto design = evaluator.build(longer, diag);
+  ASSERT_TRUE(design) << diag.format();
+  ASSERT_EQ(design->model.segment_choices.size(), 1u);
+  EXPECT_EQ(design->model.segment_choices[0].segments, own.segments);
+  EXPECT_TRUE(design->model.segment_choices[0].pinned);
+  EXPECT_EQ(static_cast<long>(design->model.beams.size()), own.segments);
+
+  const auto alone = load_study(evaluator.document(longer), "reuse.json", ".", diag);
+  ASSERT_TRUE(alone) << diag.format();
+  EXPECT_EQ(alone->model.segment_choices[0].frequencies_checked, 3);
+  EXPECT_GT(alone->model.segment_choices[0].segments, own.segments);
+  EXPECT_FALSE(alone->model.segment_choices[0].pinned);
+}
+
 }  // namespace
 }  // namespace beamrail

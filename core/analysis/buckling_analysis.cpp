@@ -147,8 +147,9 @@ BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, 
   if (symmetric_reference && asymmetry > kModalAsymmetryLimit)
     throw std::runtime_error(
         text("the reference state's tangent stiffness is not symmetric (relative asymmetry "
-             "%.2g): torques of fixed direction load it, which are not conservative; linear "
-             "buckling does not apply (a static analysis's stability check does)",
+             "%.2g): torques of fixed direction or follower loads load it, which are not "
+             "conservative; linear buckling does not apply (a static analysis's stability check "
+             "does)",
              asymmetry));
   // The scaled loads at the reference, P1 (generalized forces, dim n_dofs).
   for (Vec6& w : data.wrench) w.setZero();
@@ -156,11 +157,19 @@ BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, 
   const Eigen::VectorXd p1 = wrench_vector(scaled, data);
   if (!(p1.lpNorm<Eigen::Infinity>() > 0.0))
     throw std::runtime_error("the loads to scale are zero at the loads' time: nothing buckles");
-  for (const Load& load : scaled.loads)
-    if (load.kind == LoadKind::kTorque && load.time(t) * load.value != Vec3::Zero())
+  for (const Load& load : scaled.loads) {
+    if (is_conservative(load) || load.time(t) * load.value == Vec3::Zero()) continue;
+    if (!load.follows)
       throw std::runtime_error(
           "a torque of fixed direction is among the loads to scale: it is not conservative; "
           "linear buckling does not apply (a static analysis's stability check does)");
+    // Beck's column (a tangential tip force) has no buckling load at all: it flutters.
+    throw std::runtime_error(
+        "a follower load is among the loads to scale: it is not conservative and may lose "
+        "stability by flutter, which linear buckling cannot find; use a modal analysis about the "
+        "static equilibrium (it fails where vibrations grow) or a static analysis's stability "
+        "check at the loads of interest");
+  }
 
   out.llt = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>(out.k0);
   if (out.llt->info() != Eigen::Success)
@@ -195,7 +204,7 @@ BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, 
   const auto add_load_part = [&](const Model& m, bool turning) {
     for (const Load& load : m.loads) {
       const int k = m.bodies[load.body].free_index;
-      if (k < 0 || load.kind != LoadKind::kForce) continue;
+      if (k < 0 || !is_conservative(load)) continue;  // refused above
       const Vec3 force = load.time(t) * load.value;
       const Vec3 lever = data.pose[load.body].A * load.offset;
       const Vec3 theta = u1.segment<3>(kDofsPerBody * k + 3);

@@ -18,7 +18,8 @@
 // The reference state's stiffness must be positive definite: every free body held (a free body or
 // a carriage free along its rails has no stiffness against motion there, and a buckling factor
 // along such a direction means nothing). Loads that are not conservative (torques of fixed
-// direction make the tangent non-symmetric) are refused.
+// direction and follower loads make the tangent non-symmetric) are refused: a follower load may
+// lose stability by flutter, which the modal and static analyses detect and this one cannot.
 #pragma once
 
 #include <Eigen/Core>

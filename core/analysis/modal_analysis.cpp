@@ -143,11 +143,12 @@ bool solve_lanczos(const SparseMatrix& k, const SparseMatrix& m, double shift, E
   return true;
 }
 
-// Whether torques (of fixed direction) load the state linearized.
-bool loaded_by_torques(const Model& model, const ModalOptions& options) {
+// Whether loads without a potential (torques of fixed direction, follower loads) load the state
+// linearized.
+bool loaded_nonconservatively(const Model& model, const ModalOptions& options) {
   if (options.load_factor == 0.0) return false;
   for (const Load& load : model.loads)
-    if (load.kind == LoadKind::kTorque && load.value != Vec3::Zero()) return true;
+    if (!is_conservative(load) && load.value != Vec3::Zero()) return true;
   return false;
 }
 
@@ -469,7 +470,8 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     const int wanted = std::max(1, options.modes);
     const Eigen::Index n = model.n_dofs;
     result.shift = choose_shift(model, sym, m);
-    // Torques of fixed direction make the loaded state non-conservative and K non-symmetric
+    // Torques of fixed direction and follower loads make the loaded state non-conservative and K
+    // non-symmetric
     // at equilibrium: its own eigenproblem then, never its symmetric part (a cantilever bent by
     // a tip torque: 3.485 Hz from the symmetric part, 3.645 Hz from the non-symmetric problem
     // and from a transient). Rounding leaves ~1e-15.
@@ -530,7 +532,8 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
       throw std::runtime_error(
           "the configuration flutters: " + std::to_string(complex_pairs) +
           " pair(s) of complex eigenvalues (|Im w^2| / |w^2| up to " + growth_text +
-          "), vibrations that grow: the torques of fixed direction feed them energy");
+          "), vibrations that grow: the loads without a potential (torques of fixed direction, "
+          "follower loads) feed them energy");
     }
     result.ok = true;
     participations(model, data, m, result);
@@ -591,11 +594,12 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
           "the configuration is not a stable equilibrium: " + std::to_string(unstable) +
           " mode(s) with negative stiffness (buckling, or an unstable equilibrium)";
     }
-    if (result.ok && nonsymmetric && !loaded_by_torques(model, options))
+    if (result.ok && nonsymmetric && !loaded_nonconservatively(model, options))
       result.warnings.push_back(
           "the tangent stiffness is not symmetric (relative asymmetry " +
           std::to_string(result.asymmetry) +
-          ") although no torque loads the scene: the configuration is not an equilibrium");
+          ") although no torque or follower load loads the scene: the configuration is not an "
+          "equilibrium");
   } catch (const DeadlinePassed&) {
     result.ok = false;
     result.timed_out = true;

@@ -10,7 +10,8 @@
 // with free bodies or rails may have rigid-body or mechanism modes: mu is then a small positive
 // multiple of the stiffness scale.
 //
-// Torques of fixed direction do no conservative work: at an equilibrium under them K is not
+// Torques of fixed direction and follower loads do no conservative work: at an equilibrium under
+// them K is not
 // symmetric (relative asymmetry above kModalAsymmetryLimit), and the modes are those of the
 // non-symmetric problem (dense, or Arnoldi with shift-invert by a sparse LU); complex eigenvalues
 // (flutter) fail the analysis.
@@ -127,7 +128,8 @@ double modal_assurance(const Eigen::VectorXd& a, const Eigen::VectorXd& b,
 inline constexpr double kModalNoiseError = 1e-3;
 inline constexpr double kModalNoiseWarning = 1e-4;
 inline constexpr double kModalNoiseLimit = 1.0;
-// Above this asymmetry the non-symmetric eigenproblem of K is solved (torques of fixed direction;
+// Above this asymmetry the non-symmetric eigenproblem of K is solved (torques of fixed direction,
+// follower loads;
 // rounding leaves ~1e-15), below it the symmetric one of its symmetric part.
 inline constexpr double kModalAsymmetryLimit = 1e-10;
 

@@ -440,7 +440,8 @@ struct Stability {
 // Under conservative loads the tangent K is symmetric at an equilibrium: the negative pivots of
 // an LDL^T of K count its negative eigenvalues (Sylvester's law of inertia), shifted by a small
 // multiple of the mass where rigid-body or mechanism directions (zero stiffness) may exist.
-// Torques of fixed direction do no conservative work and make K non-symmetric: its symmetric part
+// Torques of fixed direction and follower loads do no conservative work and make K
+// non-symmetric: its symmetric part
 // says nothing then (a clamped beam bent into a circle by a tip torque is stable, its symmetric
 // part indefinite). The small vibrations M x'' + K x = 0 are bounded when every eigenvalue of
 // K x = lambda M x is real and positive: a negative one diverges, a complex pair flutters. Up to
@@ -621,8 +622,9 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
         if (stable.negative > 0 && stable.flutter > 0) result.message += "; ";
         if (stable.flutter > 0)
           result.message += std::to_string(stable.flutter) +
-                            " pair(s) of its small vibrations grow (flutter: the torques of "
-                            "fixed direction feed them energy)";
+                            " pair(s) of its small vibrations grow (flutter: the loads without a "
+                            "potential, torques of fixed direction or follower loads, feed them "
+                            "energy)";
       }
     }
     if (result.ok && result.residual_norm > std::max(options.tolerance, 1e-6) * f_ref)

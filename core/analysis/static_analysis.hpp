@@ -16,7 +16,8 @@
 //    the load;
 //  - stability: the tangent stiffness at the equilibrium has no negative direction (a column
 //    loaded beyond its buckling load, whose straight state is an unstable equilibrium, fails);
-//    under torques of fixed direction (non-conservative, a non-symmetric tangent) no small
+//    under torques of fixed direction or follower loads (non-conservative, a non-symmetric
+//    tangent) no small
 //    vibration grows: no negative real or complex eigenvalue of K x = lambda M x (all of them up
 //    to 120 degrees of freedom; beyond, the 12 nearest zero and the sign of det K);
 //  - range: every element is inside the range of its law (core/analysis/deformation_check.hpp),
@@ -63,7 +64,7 @@ struct StaticResult {
   int load_steps = 0;            // load increments taken
   int singular_directions = 0;   // tangent directions with no stiffness (solved minimum-norm)
   int negative_directions = 0;   // of the tangent at the equilibrium (> 0: unstable, not ok)
-  int flutter_pairs = 0;  // growing vibration pairs under torques of fixed direction (> 0: not ok)
+  int flutter_pairs = 0;  // growing vibration pairs under non-conservative loads (> 0: not ok)
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
 };

@@ -5,14 +5,22 @@
 #include "core/model/rail.hpp"
 
 namespace beamrail {
+// The load's force or torque at time t in global axes: a follower load's value is in body axes
+// and turns with the body.
+Vec3 load_value(const Load& load, const Pose<double>& pose, double t, double load_factor) {
+  const Vec3 value = load_factor * load.time(t) * load.value;
+  return load.follows ? Vec3(pose.A * value) : value;
+}
+
 void add_load_wrenches(const Model& model, Data& data, double t, double load_factor) {
   for (int i : model.free_bodies)
     data.wrench[i].head<3>() += load_factor * model.bodies[i].mass * model.gravity;
   for (const Load& load : model.loads) {
-    const Vec3 value = load_factor * load.time(t) * load.value;
+    const Pose<double>& pose = data.pose[load.body];
+    const Vec3 value = load_value(load, pose, t, load_factor);
     Vec6& w = data.wrench[load.body];
     if (load.kind == LoadKind::kForce) {
-      const Vec3 lever = data.pose[load.body].A * load.offset;
+      const Vec3 lever = pose.A * load.offset;
       w.head<3>() += value;
       w.tail<3>() += lever.cross(value);
     } else {
@@ -22,15 +30,31 @@ void add_load_wrenches(const Model& model, Data& data, double t, double load_fac
 }
 
 void add_load_stiffness(const Model& model, Data& data, double t, double load_factor) {
-  // Loads at body points: the moment lever turns with the body, d(R x F)/dtheta = [F]x [R]x.
+  // A rotation increment dtheta (A -> exp([dtheta]x) A) turns every vector carried by the body:
+  // dV = dtheta x V = -[V]x dtheta.
   for (const Load& load : model.loads) {
     const int k = model.bodies[load.body].free_index;
-    if (k < 0 || load.kind != LoadKind::kForce) continue;
-    const Vec3 value = load_factor * load.time(t) * load.value;
-    const Vec3 lever = data.pose[load.body].A * load.offset;
-    data.stiffness[k].block<3, 3>(3, 3) += skew<double>(value) * skew<double>(lever);
+    if (k < 0) continue;
+    const Pose<double>& pose = data.pose[load.body];
+    const Vec3 value = load_value(load, pose, t, load_factor);
+    Mat6& s = data.stiffness[k];
+    if (load.kind == LoadKind::kForce) {
+      const Vec3 lever = pose.A * load.offset;
+      if (load.follows) {
+        // F and R both turn: dF = -[F]x dtheta, d(R x F) = dtheta x (R x F).
+        s.block<3, 3>(0, 3) -= skew<double>(value);
+        s.block<3, 3>(3, 3) -= skew<double>(lever.cross(value));
+      } else {
+        // Only the lever turns: d(R x F) = (dtheta x R) x F = [F]x [R]x dtheta.
+        s.block<3, 3>(3, 3) += skew<double>(value) * skew<double>(lever);
+      }
+    } else if (load.follows) {
+      s.block<3, 3>(3, 3) -= skew<double>(value);  // dM = -[M]x dtheta
+    }
   }
 }
+
+bool is_conservative(const Load& load) { return load.kind == LoadKind::kForce && !load.follows; }
 
 namespace {
 

@@ -25,9 +25,19 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
 void add_load_wrenches(const Model& model, Data& data, double t, double load_factor);
 
 // Adds the loads' part of the tangent, scaled by load_factor, to data.stiffness (part of
-// compute_tangent): a force at a body point turns its lever with the body, d(R x F)/dtheta =
-// [F]x [R]x. Gravity acts at the centres and adds none.
+// compute_tangent): a force of fixed direction at a body point turns its lever with the body,
+// d(R x F)/dtheta = [F]x [R]x; a follower load turns with the body as a whole, dF/dtheta =
+// -[F]x and d(R x F)/dtheta = -[R x F]x for a force, dM/dtheta = -[M]x for a torque (not
+// symmetric). Gravity acts at the centres and adds none.
 void add_load_stiffness(const Model& model, Data& data, double t, double load_factor);
+
+// The load's force or torque at time t, scaled by load_factor, in global axes in the pose given
+// (a follower load's body-axes value turned by pose.A).
+Vec3 load_value(const Load& load, const Pose<double>& pose, double t, double load_factor = 1.0);
+
+// Whether the load has a potential: a force of fixed direction. A torque of fixed direction and a
+// follower load have none (their work depends on the path) and make the tangent non-symmetric.
+bool is_conservative(const Load& load);
 
 // Kinetic energy of all free bodies [J].
 double kinetic_energy(const Model& model, const Data& data);

@@ -22,7 +22,8 @@ Eigen::SparseMatrix<double> stiffness_matrix(const Model& model, const Data& dat
 // entries). *asymmetry = |W (S - S^T) W| / |W S W| (Frobenius norms, W = diag(weight)): with
 // weights that make the entries comparable (1 / sqrt(M_ii), or 1 / sqrt(|S_ii|)) it does not
 // depend on the units of length and angle. K is symmetric at an equilibrium under conservative
-// loads (rounding leaves ~1e-15); torques of fixed direction make it non-symmetric.
+// loads (rounding leaves ~1e-15); torques of fixed direction and follower loads make it
+// non-symmetric.
 Eigen::SparseMatrix<double> symmetric_stiffness(const Model& model, const Data& data,
                                                 const Eigen::VectorXd& weight, double* asymmetry);
 

@@ -91,7 +91,11 @@ struct Load {
   LoadKind kind = LoadKind::kForce;
   int body = 0;
   Vec3 offset = Vec3::Zero();  // force: point of application in body axes, from the centre [m]
-  Vec3 value = Vec3::Zero();   // global axes [N] or [N m], scaled by time(t)
+  // [N] or [N m], scaled by time(t): in global axes, or in body axes when `follows`
+  Vec3 value = Vec3::Zero();
+  // A follower load: its value is fixed in the body frame and turns with the body (global value
+  // A value); otherwise its direction stays fixed in global axes.
+  bool follows = false;
   TimeFunction time;
   std::string load_case;  // the load case it belongs to; empty: none (applied by every analysis)
 };

@@ -434,12 +434,14 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     if (!r.is_object()) return;
     Load load;
     const auto type = r.choice("type", true, {"force", "torque"});
-    if (!type) r.allow({"point", "case"});
+    if (!type) r.allow({"point", "case", "follows"});
     const auto body = body_ref(r, "body", specs);
     std::optional<Vec3> point;
     if (type && *type == "force") point = r.vec3("point", false);
     const auto value = r.vec3("value", true);
     const auto load_case = r.string("case", false);
+    const auto follows = r.boolean("follows", false);
+    const bool follows_bad = !follows && v.contains("follows");  // reported by r.boolean
     if (load_case && load_case->empty())
       r.error("case", "must not be empty (omit it for a load of every analysis)");
     std::optional<TimeFunction> time = TimeFunction{};
@@ -449,7 +451,8 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
               "body \"" + specs.bodies[*body].name + "\" is fixed: a load on it does nothing");
       return;
     }
-    if (!type || !body || !value || !time || (load_case && load_case->empty())) return;
+    if (!type || !body || !value || !time || follows_bad || (load_case && load_case->empty()))
+      return;
     if (load_case) {
       load.load_case = *load_case;
       if (std::find(specs.load_cases.begin(), specs.load_cases.end(), *load_case) ==
@@ -458,7 +461,12 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     }
     load.kind = *type == "force" ? LoadKind::kForce : LoadKind::kTorque;
     load.body = *body;
-    load.value = *value;
+    // A follower load keeps the value given (global axes, initial configuration) in body axes.
+    load.follows = follows.value_or(false);
+    load.value =
+        load.follows
+            ? Vec3(rotation_matrix<double>(specs.bodies[*body].orientation).transpose() * *value)
+            : *value;
     load.time = *time;
     specs.loads.push_back(load);
     specs.load_points.push_back(point.value_or(specs.bodies[*body].position));

@@ -66,7 +66,7 @@ struct AnalysisReport {
   double shift = 0.0;  // of the inverse problem [1/s^2]
   double noise = 0.0;  // largest Mode::noise among the modes found
   double asymmetry = 0.0;
-  bool nonsymmetric = false;  // the non-symmetric eigenproblem (torques of fixed direction)
+  bool nonsymmetric = false;  // the non-symmetric eigenproblem (non-conservative loads)
   // per direction x .. rz: the effective mass of the modes computed (rigid ones included) over
   // the total; near 1 when the modes computed capture the scene's response to a base motion
   Vec6 effective_mass_captured = Vec6::Zero();

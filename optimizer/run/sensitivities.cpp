@@ -76,7 +76,8 @@ ResponseSensitivities Sensitivities::run(const std::vector<const Study*>& plus,
         states.analyses[r.analysis].nonsymmetric) {
       out.message = "response \"" + r.name +
                     "\" is a frequency of a non-symmetric eigenproblem (torques of fixed "
-                    "direction): no exact derivative; use \"gradient\": \"fd\"";
+                    "direction or follower loads): no exact derivative; use \"gradient\": "
+                    "\"fd\"";
       return out;
     }
   }

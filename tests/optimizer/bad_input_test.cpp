@@ -558,6 +558,28 @@ TEST_F(BadInput, LoadOnAFixedBody) {
                            "bad.json:/scene/loads/1/body:", "body \"ground\" is fixed"));
 }
 
+// "follows" is true or false; anything else is one error at its pointer, and a misspelling is an
+// unknown key with the hint. A valid follower load passes the check.
+TEST_F(BadInput, FollowerLoadFlag) {
+  const struct {
+    Json value;
+    const char* got;
+  } cases[] = {{"yes", "got a string"}, {1, "got a number"}, {Json::array({true}), "got an array"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.value.dump());
+    EXPECT_TRUE(HasOnlyError(
+        check(with("/scene/loads/1/follows", c.value)),
+        "bad.json:/scene/loads/1/follows:", std::string("expected true or false, ") + c.got));
+  }
+  EXPECT_TRUE(HasOnlyError(
+      check(with("/scene/loads/0/follow", true)),
+      "bad.json:/scene/loads/0/follow:", "unknown key \"follow\" (did you mean \"follows\"?)"));
+  Json study = with("/scene/loads/0/follows", true);
+  study["scene"]["loads"][1]["follows"] = false;
+  const Result ok = check(study);
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
+}
+
 TEST_F(BadInput, TableTimesNotIncreasing) {
   EXPECT_TRUE(
       HasOnlyError(check(with("/scene/loads/1/time/t", {0, 0.2, 0.1})),

@@ -289,5 +289,63 @@ TEST(Sensitivities, ResponsesWithoutExactDerivativesSaySo) {
       << s.message;
 }
 
+// A follower tip force (turned 0.24 rad with the tip): the equilibrium's derivatives are exact
+// (the full tangent, its non-symmetric load stiffness included), against extrapolated central
+// differences of whole evaluations; the frequencies about that equilibrium (a non-symmetric
+// eigenproblem) have none, and say so.
+TEST(Sensitivities, FollowerLoadEquilibriumIsExactItsFrequenciesAreRefused) {
+  std::string text = kCantilever;
+  const std::string dead = R"("value": [0, -3, 0]})";
+  text.replace(text.find(dead), dead.size(), R"("value": [0, -100, 0], "follows": true})");
+  const std::string dy =
+      R"("dy": {"quantity": "displacement", "body": "tip", "direction": [0, -1, 0]},)";
+  text.replace(
+      text.find(dy), dy.size(),
+      dy + R"("dx": {"quantity": "displacement", "body": "tip", "direction": [1, 0, 0]},)");
+  const std::string frequencies = R"(,
+    "f1": {"quantity": "frequency", "mode": 1},
+    "f2": {"quantity": "frequency", "mode": 2}})";
+  const size_t at_frequencies = text.find(frequencies);
+  const std::string statics =
+      text.substr(0, at_frequencies) + "}" + text.substr(at_frequencies + frequencies.size());
+  Diagnostics diag;
+  const auto study = load(statics, diag);
+  ASSERT_TRUE(study) << diag.format();
+  const DesignEvaluator evaluator(*study);
+  const std::vector<double> x = values(*study);
+  const Result r = at(evaluator, x);
+  ASSERT_TRUE(r.s.ok) << r.s.message;
+  for (size_t j = 0; j < x.size(); ++j) {
+    const auto central = [&](double h) {
+      std::vector<double> up = x, down = x;
+      up[j] += h, down[j] -= h;
+      const DesignOutcome u = evaluator.evaluate(up), d = evaluator.evaluate(down);
+      return Eigen::Vector2d((u.responses[0] - d.responses[0]) / (2 * h),
+                             (u.responses[1] - d.responses[1]) / (2 * h));
+    };
+    const double h = 1e-3 * std::abs(x[j]);
+    const Eigen::Vector2d reference = (4 * central(h / 2) - central(h)) / 3;
+    for (int k = 0; k < 2; ++k) {
+      std::printf("follower load: d %s / d %s = %.10e (differences %.10e)\n",
+                  study->responses[k].name.c_str(), study->design->variables[j].name.c_str(),
+                  r.s.jacobian(k, j), reference(k));
+      EXPECT_NEAR(r.s.jacobian(k, j), reference(k), 1e-6 * std::abs(reference(k)));
+    }
+  }
+
+  text.replace(text.find(R"("about": "initial")"), 18, R"("about": "static")");
+  const auto modal = load(text, diag);
+  ASSERT_TRUE(modal) << diag.format();
+  const DesignEvaluator modal_evaluator(*modal);
+  ResponseSensitivities s;
+  const DesignOutcome o = modal_evaluator.evaluate(values(*modal), &s);
+  ASSERT_EQ(o.status, Status::kOk) << o.message;
+  EXPECT_FALSE(s.ok);
+  EXPECT_NE(s.message.find("\"f1\" is a frequency of a non-symmetric eigenproblem (torques of "
+                           "fixed direction or follower loads)"),
+            std::string::npos)
+      << s.message;
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -1,6 +1,9 @@
 #include "core/scene/auto_segments.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <Spectra/MatOp/SparseSymShiftSolve.h>
+#include <Spectra/SymEigsShiftSolver.h>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,40 +12,60 @@
 
 namespace beamrail {
 
-std::vector<double> cantilever_bending_frequencies(const UniformBeam& beam, int plane, long n) {
+std::vector<double> cantilever_bending_frequencies(const UniformBeam& beam, int plane, long n,
+                                                   long count) {
   const double l = beam.length / static_cast<double>(n);
   const double ei = beam.ei[plane], m = beam.rho_area * l;
   const double j = beam.rho_i[plane] * l + m * l * l / 12.0;
-  // Degrees of freedom (w, theta) of nodes 1..n; node 0 is clamped.
-  const int dofs = static_cast<int>(2 * n);
-  Eigen::MatrixXd k = Eigen::MatrixXd::Zero(dofs, dofs);
-  Eigen::Matrix4d ke;
-  ke << 12, 6 * l, -12, 6 * l,              //
-      6 * l, 4 * l * l, -6 * l, 2 * l * l,  //
-      -12, -6 * l, 12, -6 * l,              //
-      6 * l, 2 * l * l, -6 * l, 4 * l * l;
-  ke *= ei / (l * l * l);
-  for (long e = 0; e < n; ++e) {
-    // Element e joins nodes e and e + 1; node i's dofs start at 2 (i - 1).
-    const int first = static_cast<int>(2 * (e - 1));
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c)
-        if (first + r >= 0 && first + c >= 0) k(first + r, first + c) += ke(r, c);
-  }
-  Eigen::VectorXd mass(dofs);
+  // Degrees of freedom (w, theta) of nodes 1..n; node 0 is clamped. K phi = lambda M phi with M
+  // diagonal becomes the symmetric A = M^-1/2 K M^-1/2 (banded: nodes couple to neighbours only).
+  const Eigen::Index dofs = 2 * n;
+  Eigen::VectorXd d(dofs);
   for (long i = 1; i <= n; ++i) {
     const double share = i == n ? 0.5 : 1.0;
-    mass(2 * (i - 1)) = share * m;
-    mass(2 * (i - 1) + 1) = share * j;
+    d(2 * (i - 1)) = 1.0 / std::sqrt(share * m);
+    d(2 * (i - 1) + 1) = 1.0 / std::sqrt(share * j);
   }
-  // K phi = lambda M phi with M diagonal: the symmetric M^-1/2 K M^-1/2.
-  const Eigen::VectorXd d = mass.cwiseInverse().cwiseSqrt();
-  const Eigen::MatrixXd a = d.asDiagonal() * k * d.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, Eigen::EigenvaluesOnly);
+  Eigen::Matrix4d ke;
+  ke << 12, 6 * l, -12, 6 * l,  //
+      6 * l, 4 * l * l, -6 * l, 2 * l * l,  //
+      -12, -6 * l, 12, -6 * l,  //
+      6 * l, 2 * l * l, -6 * l, 4 * l * l;
+  ke *= ei / (l * l * l);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(16 * n);
+  for (long e = 0; e < n; ++e) {
+    // Element e joins nodes e and e + 1; node i's dofs start at 2 (i - 1).
+    const Eigen::Index first = 2 * (e - 1);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c)
+        if (first + r >= 0 && first + c >= 0)
+          entries.emplace_back(first + r, first + c, d(first + r) * ke(r, c) * d(first + c));
+  }
+  Eigen::SparseMatrix<double> a(dofs, dofs);
+  a.setFromTriplets(entries.begin(), entries.end());
+  const auto hz = [](double lambda) {
+    return std::sqrt(std::max(lambda, 0.0)) / (2.0 * std::numbers::pi);
+  };
   std::vector<double> f;
-  f.reserve(dofs);
-  for (int i = 0; i < dofs; ++i)
-    f.push_back(std::sqrt(std::max(eig.eigenvalues()(i), 0.0)) / (2.0 * std::numbers::pi));
+  if (count > 0 && count < dofs / 4 && dofs > 64) {
+    // The lowest few only: shift-invert Lanczos about 0 (A is positive definite), O(n) per step.
+    Spectra::SparseSymShiftSolve<double> op(a);
+    Spectra::SymEigsShiftSolver<Spectra::SparseSymShiftSolve<double>> eigs(
+        op, count, std::min<Eigen::Index>(dofs, std::max<Eigen::Index>(2 * count + 1, 20)), 0.0);
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-13);
+    if (eigs.info() == Spectra::CompInfo::Successful) {
+      for (Eigen::Index i = 0; i < eigs.eigenvalues().size(); ++i)
+        f.push_back(hz(eigs.eigenvalues()(i)));
+      std::sort(f.begin(), f.end());
+      return f;
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Eigen::MatrixXd(a),
+                                                           Eigen::EigenvaluesOnly);
+  const Eigen::Index keep = count > 0 ? std::min<Eigen::Index>(count, dofs) : dofs;
+  for (Eigen::Index i = 0; i < keep; ++i) f.push_back(hz(eig.eigenvalues()(i)));
   return f;
 }
 
@@ -65,13 +88,20 @@ SegmentChoice choose_segments(const std::string& name, const UniformBeam& beam,
                               const SegmentationTarget& target) {
   static constexpr long kLadder[] = {1,  2,  3,  4,  5,  6,  8,  10, 12, 14,  16, 20,
                                      24, 28, 32, 40, 48, 56, 64, 80, 96, 112, 128};
-  std::map<std::pair<int, long>, std::vector<double>> cache;
-  const auto frequencies = [&](int plane, long n) -> const std::vector<double>& {
-    auto it = cache.find({plane, n});
-    if (it == cache.end())
-      it = cache.emplace(std::make_pair(plane, n), cantilever_bending_frequencies(beam, plane, n))
-               .first;
-    return it->second;
+  // Per (plane, count of segments): the lowest frequencies computed so far, and whether they are
+  // all the chain has.
+  struct Computed {
+    std::vector<double> values;
+    bool all = false;
+  };
+  std::map<std::pair<int, long>, Computed> cache;
+  const auto frequencies = [&](int plane, long n, size_t wanted) -> const std::vector<double>& {
+    Computed& c = cache[{plane, n}];
+    if (c.values.size() < wanted && !c.all) {
+      c.values = cantilever_bending_frequencies(beam, plane, n, static_cast<long>(wanted));
+      c.all = c.values.size() < wanted || c.values.size() == static_cast<size_t>(2 * n);
+    }
+    return c.values;
   };
   SegmentChoice out;
   out.beam = name;
@@ -79,12 +109,17 @@ SegmentChoice choose_segments(const std::string& name, const UniformBeam& beam,
     double worst = 0.0;
     int checked = 0;
     for (int plane = 0; plane < 2; ++plane) {
-      const std::vector<double>& coarse = frequencies(plane, n);
-      const std::vector<double>& fine = frequencies(plane, 2 * n);
-      const std::vector<double>& finer = frequencies(plane, 4 * n);
-      // Every frequency up to the band (the first always), from the finest chain's values.
+      // Every frequency up to the band (the first always), from the finest chain's values, and
+      // the next one.
+      size_t wanted = 2;
+      while (frequencies(plane, 4 * n, wanted).size() == wanted &&
+             frequencies(plane, 4 * n, wanted).back() <= target.max_frequency_hz)
+        wanted *= 2;
+      const std::vector<double>& finer = frequencies(plane, 4 * n, wanted);
       size_t count = 1;
       while (count < finer.size() && finer[count] <= target.max_frequency_hz) ++count;
+      const std::vector<double>& coarse = frequencies(plane, n, count + 1);
+      const std::vector<double>& fine = frequencies(plane, 2 * n, count + 1);
       checked = std::max(checked, static_cast<int>(count));
       for (size_t k = 0; k < count; ++k)
         worst = std::max(worst, estimated_error(coarse, fine, finer, k));
@@ -98,7 +133,7 @@ SegmentChoice choose_segments(const std::string& name, const UniformBeam& beam,
     out.segments = n;
     out.estimated_error = worst;
     out.frequencies_checked = checked;
-    out.first_frequency_hz = std::min(frequencies(0, n)[0], frequencies(1, n)[0]);
+    out.first_frequency_hz = std::min(frequencies(0, n, 1)[0], frequencies(1, n, 1)[0]);
     if (worst <= target.frequency_error) return out;
   }
   out.reached = false;

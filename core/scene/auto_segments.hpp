@@ -39,8 +39,10 @@ struct UniformBeam {
 // The bending frequencies [Hz], ascending, in the plane about local y (plane 0) or z (plane 1) of
 // the beam clamped at one end and free at the other, split into n segments as beamrail splits it:
 // Euler-Bernoulli segments of length l = L/n, interior bodies of mass rho S l and rotary inertia
-// rho I l + rho S l^3 / 12, the free end half of that (rho I l / 2 + rho S l^3 / 24).
-std::vector<double> cantilever_bending_frequencies(const UniformBeam& beam, int plane, long n);
+// rho I l + rho S l^3 / 12, the free end half of that (rho I l / 2 + rho S l^3 / 24). The lowest
+// `count` of them (all 2n when count is 0 or at least 2n).
+std::vector<double> cantilever_bending_frequencies(const UniformBeam& beam, int plane, long n,
+                                                   long count = 0);
 
 // The largest count the rule picks; beyond it the target is reported as missed.
 inline constexpr long kMaxAutoSegments = 128;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/analysis/stop_request.hpp"
+#include "optimizer/batch/wire.hpp"
 #endif
 
 namespace beamrail {
@@ -49,83 +50,17 @@ namespace {
 // Message tags: rank 0 sends the study, designs and the stop; the others send outcomes.
 constexpr int kTagStudy = 1, kTagWork = 2, kTagResult = 3, kTagStop = 4;
 
-// Messages are byte strings: numbers in the machine's own representation (every rank of a job
-// runs the same binary), strings as a length and their bytes.
-class Packer {
- public:
-  template <typename T>
-  void put(T value) {
-    append(&value, sizeof(T));
-  }
-  void put_string(const std::string& s) {
-    put<int64_t>(static_cast<int64_t>(s.size()));
-    append(s.data(), s.size());
-  }
-  void put_doubles(const std::vector<double>& v) {
-    put<int64_t>(static_cast<int64_t>(v.size()));
-    for (double x : v) put(x);
-  }
-  std::vector<char> bytes;
-
- private:
-  void append(const void* data, size_t n) {
-    if (n == 0) return;
-    const size_t at = bytes.size();
-    bytes.resize(at + n);
-    std::memcpy(bytes.data() + at, data, n);
-  }
-};
-
-class Unpacker {
- public:
-  explicit Unpacker(const std::vector<char>& bytes) : bytes_(bytes) {}
-  template <typename T>
-  T get() {
-    T value{};
-    if (at_ + sizeof(T) <= bytes_.size()) std::memcpy(&value, bytes_.data() + at_, sizeof(T));
-    at_ += sizeof(T);
-    return value;
-  }
-  std::string get_string() {
-    const size_t n = static_cast<size_t>(get<int64_t>());
-    if (at_ + n > bytes_.size()) return {};
-    std::string s(bytes_.data() + at_, n);
-    at_ += n;
-    return s;
-  }
-  std::vector<double> get_doubles() {
-    const size_t n = static_cast<size_t>(get<int64_t>());
-    std::vector<double> v;
-    if (at_ + n * sizeof(double) > bytes_.size()) return v;
-    v.reserve(n);
-    for (size_t i = 0; i < n; ++i) v.push_back(get<double>());
-    return v;
-  }
-
- private:
-  const std::vector<char>& bytes_;
-  size_t at_ = 0;
-};
-
 std::vector<char> pack_result(long index, const DesignOutcome& o) {
   Packer p;
   p.put<int64_t>(index);
-  p.put<int32_t>(static_cast<int32_t>(o.status));
-  p.put<int32_t>(o.warnings);
-  p.put<double>(o.wall_seconds);
-  p.put_doubles(o.responses);
-  p.put_string(o.message);
+  p.put_outcome(o);
   return std::move(p.bytes);
 }
 
 long unpack_result(const std::vector<char>& bytes, DesignOutcome* o) {
   Unpacker u(bytes);
   const long index = static_cast<long>(u.get<int64_t>());
-  o->status = static_cast<Status>(u.get<int32_t>());
-  o->warnings = u.get<int32_t>();
-  o->wall_seconds = u.get<double>();
-  o->responses = u.get_doubles();
-  o->message = u.get_string();
+  *o = u.get_outcome();
   return index;
 }
 

@@ -9,7 +9,9 @@
 #include <mutex>
 
 #include "core/analysis/stop_request.hpp"
+#include "optimizer/batch/mpi_job.hpp"
 #include "optimizer/batch/progress.hpp"
+#include "optimizer/batch/start_task.hpp"
 #include "optimizer/output/optimization_report.hpp"
 #include "optimizer/output/summary.hpp"
 
@@ -99,6 +101,16 @@ std::vector<double> constraint_scales(const OptimizePlan& plan, const DesignOutc
   return scales;
 }
 
+// A start that never ran (the batch stopped first): stopped by beamrail before its first design.
+StartResult not_run(const OptimizationProblem& problem, int index) {
+  StartResult r;
+  r.index = index;
+  r.result = NLOPT_FORCED_STOP;
+  r.stopped = true;
+  r.objective_scale = problem.plan().objective_scale.value_or(1.0);
+  return r;
+}
+
 }  // namespace
 
 OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluator& evaluator,
@@ -116,14 +128,19 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
 
   const std::vector<Design> points = problem.start_points();
   const int n_starts = static_cast<int>(points.size());
+  MpiJob* job = mpi_job();
+  const bool spread = job && job->size() > 1;
   // Designs evaluated at once in one process: the starts, the central-difference points of one
   // gradient, or the variables whose derivatives one design's sensitivities compute in parallel.
+  // Under mpirun each rank runs one start at a time with -j threads (default 1).
   const long n_variables = static_cast<long>(problem.variables().size());
   const long at_once =
       std::max(static_cast<long>(n_starts), !needs_gradient(plan.algorithm) ? 1
                                             : problem.exact_gradients()     ? n_variables
                                                                             : 2 * n_variables + 1);
-  run.threads = batch_threads(settings, at_once);
+  run.ranks = spread ? job->size() : 1;
+  run.threads =
+      spread ? (settings.threads > 0 ? settings.threads : 1) : batch_threads(settings, at_once);
   omp_set_num_threads(run.threads);  // the sensitivities' parallel loops
   const long budget = static_cast<long>(plan.max_evaluations) * n_starts;
   Progress progress(budget, settings.quiet);
@@ -140,7 +157,7 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
     tasks.push_back(StartTask{s + 1, points[s], run.constraint_scales});
 
   run.starts.resize(tasks.size());
-  {
+  if (!spread) {
     // Starts side by side on the threads, sharing the cache; one start alone gets the threads
     // for its gradients' points.
 #pragma omp parallel for schedule(dynamic, 1) if (n_starts > 1) \
@@ -150,6 +167,42 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
           run_start(problem, evaluator, tasks[s], cache, run.threads, collector, cancel);
       collector.finished(run.starts[s]);
     }
+  } else {
+    // Each start goes whole to a rank with the designs it may replay: its rows of history.csv,
+    // and the first start the design evaluated above.
+    std::vector<std::vector<KnownDesign>> known(tasks.size());
+    for (const ResumedRow& r : resumed)
+      if (r.start >= 1 && r.start <= n_starts)
+        known[r.start - 1].push_back({r.x, r.outcome, false, nullptr});
+    if (first && first->status != Status::kInterrupted && n_starts > 0)
+      known[0].push_back({points[0], *first, false, nullptr});
+    std::vector<std::vector<char>> packed;
+    for (size_t s = 0; s < tasks.size(); ++s) {
+      for (KnownDesign& k : known[s]) k.has_jacobian = cache.find_jacobian(k.x, &k.jacobian);
+      packed.push_back(pack_start_task(tasks[s], known[s]));
+    }
+    run.starts_per_rank.assign(job->size(), 0);
+    TaskCallbacks callbacks;
+    callbacks.run_here = [&](const std::vector<char>& task,
+                             const std::function<void(std::vector<char>)>& send,
+                             const std::atomic<bool>& stop) {
+      return run_start_task(evaluator, run.threads, task, send, stop);
+    };
+    callbacks.message = [&](long, const std::vector<char>& message) {
+      unpack_start_message(message, collector);
+      return !cancel;
+    };
+    callbacks.finished = [&](long task, int rank, const std::vector<char>& result) {
+      StartResult& r = run.starts[task];
+      r = unpack_start_result(result);
+      r.index = static_cast<int>(task) + 1;
+      r.rank = rank;
+      ++run.starts_per_rank[rank];
+      collector.finished(r);
+    };
+    const std::vector<bool> ran = job->run_tasks(evaluator.study(), run.threads, packed, callbacks);
+    for (size_t s = 0; s < tasks.size(); ++s)
+      if (!ran[s]) run.starts[s] = not_run(problem, static_cast<int>(s) + 1);
   }
   progress.finish();
   for (const StartResult& r : run.starts) run.cost.add(r.cost);

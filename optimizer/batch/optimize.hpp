@@ -1,6 +1,7 @@
 // Design optimization with NLopt: any algorithm by name, objective (minimize, maximize, or
 // least-squares targets), inequality constraints on responses, finite-difference gradients
-// evaluated in parallel, several starts from Latin-hypercube points run side by side, and a history
+// evaluated in parallel, several starts from Latin-hypercube points, run by the threads of this
+// process or spread over the ranks of an MPI job (one start at a time per rank), and a history
 // that doubles as a cache so that an interrupted run resumes by replaying its evaluations.
 //
 // optimize() computes and hands every row to a sink; output/optimization_report.hpp writes the
@@ -31,10 +32,12 @@ struct OptimizationRun {
   std::vector<double> constraint_scales;
   EvaluationCost cost;  // of every design evaluated
   int ranks = 1, threads = 1;
+  std::vector<long> starts_per_rank;  // under mpirun
   double wall_seconds = 0.0;
 };
 
-// Runs the optimization of problem.study(): its starts on the threads of this process. Designs of earlier runs (`resumed` rows of
+// Runs the optimization of problem.study(): its starts on the threads of this process, or on the
+// ranks of the MPI job of this process (rank 0). Designs of earlier runs (`resumed` rows of
 // history.csv and `derivatives`) are replayed, not evaluated. Every row and derivative goes to
 // `out` as it is made; the run stops early (as on a stop request) once `out` is no longer good().
 OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluator& evaluator,

@@ -241,11 +241,13 @@ int run(const RunArguments& args) {
   }
 
   const StopOnSignals signals;
-  // Under mpirun the other ranks evaluate a sweep's designs; anything else runs here alone.
-  const bool sweep = study->design && study->design->type == DesignStudy::Type::kSweep;
-  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !sweep)
-    std::cerr << "beamrail: only sweeps spread over MPI ranks so far; this study runs on rank 0 "
-                 "alone (the other "
+  // Under mpirun the other ranks evaluate a sweep's designs and run an optimization's starts;
+  // anything else runs here alone.
+  const bool spread = study->design && (study->design->type == DesignStudy::Type::kSweep ||
+                                        study->design->type == DesignStudy::Type::kOptimize);
+  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !spread)
+    std::cerr << "beamrail: only sweeps and optimizations spread over MPI ranks so far; this "
+                 "study runs on rank 0 alone (the other "
               << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {

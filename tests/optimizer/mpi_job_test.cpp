@@ -149,6 +149,32 @@ bool runs(pid_t pid) {
   return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z';
 }
 
+// Ends an mpirun job as a failing node or a scheduler's hard kill does: mpirun and every process
+// it started are stopped at once (SIGSTOP, so that none writes another byte), then killed
+// (SIGKILL); killing mpirun alone would not do (its ranks run on). Returns when none runs.
+void kill_whole_job(Process& mpirun) {
+  std::vector<pid_t> job = descendants(mpirun.pid());
+  job.push_back(mpirun.pid());
+  for (pid_t pid : job) ::kill(pid, SIGSTOP);
+  for (pid_t pid : job) ::kill(pid, SIGKILL);
+  const ProcessResult r = mpirun.wait(std::chrono::seconds(30));
+  EXPECT_EQ(r.signal, SIGKILL) << r.how << "\n" << r.err;
+  EXPECT_GE(job.size(), 3u) << "mpirun and its 2 ranks";
+  const auto gone = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (pid_t pid : job)
+    while (runs(pid) && std::chrono::steady_clock::now() < gone)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  for (pid_t pid : job) ASSERT_FALSE(runs(pid)) << "process " << pid << " outlived SIGKILL";
+}
+
+// The newline-terminated lines of a table (the header and the whole rows), 0 when it is absent.
+size_t lines_of(const fs::path& table) {
+  std::error_code ec;
+  if (!fs::exists(table, ec)) return 0;
+  const std::string text = read_text(table);
+  return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
 class MpiRun : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -283,10 +309,9 @@ TEST_F(MpiRun, AJobStoppedPartWayResumesUnderMpirunWithEachDesignOnce) {
 }
 
 // A 120-design sweep of short transients under mpirun, ended part-way as a failing node or a
-// scheduler's hard kill ends a job: mpirun and every rank stopped at once (SIGSTOP, so that none
-// writes another byte), then killed (SIGKILL); killing mpirun alone would not do (the ranks run on
-// and finish the sweep). Resumed under mpirun, the job evaluates exactly the designs whose rows
-// were not in samples.csv, and the table equals one process's: nothing lost, nothing twice.
+// scheduler's hard kill ends a job (kill_whole_job; killing mpirun alone would not do: the ranks
+// run on and finish the sweep). Resumed under mpirun, the job evaluates exactly the designs whose
+// rows were not in samples.csv, and the table equals one process's: nothing lost, nothing twice.
 TEST_F(MpiRun, AJobKilledWholeResumesUnderMpirunWithNothingLostOrDuplicated) {
   Json study = tube_sweep(Json::parse(R"({"type": "sweep", "variables": [{"name": "load",
       "pointer": "/scene/loads/0/value/1", "lower": -300, "upper": -100, "count": 120}]})"));
@@ -296,30 +321,14 @@ TEST_F(MpiRun, AJobKilledWholeResumesUnderMpirunWithNothingLostOrDuplicated) {
       "body": "tip", "direction": [0, 1, 0]}})");
   const fs::path file = write_study("study.json", study);
   const fs::path samples = dir_ / "mpi" / "samples.csv";
-  auto lines_now = [&] {
-    std::error_code ec;
-    if (!fs::exists(samples, ec)) return size_t{0};
-    const std::string text = read_text(samples);
-    return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
-  };
+  auto lines_now = [&] { return lines_of(samples); };
   {
     Process p(BEAMRAIL_MPIEXEC,
               mpirun_args(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"}), dir_);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     while (lines_now() < 11 && p.alive() && std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    std::vector<pid_t> job = descendants(p.pid());
-    job.push_back(p.pid());
-    for (pid_t pid : job) ::kill(pid, SIGSTOP);
-    for (pid_t pid : job) ::kill(pid, SIGKILL);
-    const ProcessResult r = p.wait(std::chrono::seconds(30));
-    EXPECT_EQ(r.signal, SIGKILL) << r.how << "\n" << r.err;
-    EXPECT_GE(job.size(), 3u) << "mpirun and its 2 ranks";
-    const auto gone = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-    for (pid_t pid : job)
-      while (runs(pid) && std::chrono::steady_clock::now() < gone)
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    for (pid_t pid : job) ASSERT_FALSE(runs(pid)) << "process " << pid << " outlived SIGKILL";
+    ASSERT_NO_FATAL_FAILURE(kill_whole_job(p));
   }
   const size_t kept = lines_now();  // the header and the whole rows
   EXPECT_GE(kept, 11u);
@@ -436,6 +445,53 @@ TEST_F(MpiOptimization, AMultiStartOptimizationOnTwoRanksWritesTheFilesOfOneProc
 TEST_F(MpiOptimization, AnOptimizationWithExactGradientsOnThreeRanksOfTwoThreads) {
   ASSERT_NO_FATAL_FAILURE(expect_same_files(tube_optimization("LD_SLSQP", "exact"), 3, 2));
   EXPECT_TRUE(fs::exists(dir_ / "mpi" / "derivatives.csv"));
+}
+
+// An optimization of short transients from 4 starts on 2 ranks, killed whole part-way
+// (kill_whole_job), then resumed under mpirun: each rank replays its start's rows, and the
+// history and best design are those of an uninterrupted run in one process; only the designs
+// whose rows were lost with the kill are evaluated again.
+TEST_F(MpiOptimization, AnOptimizationKilledWholeResumesUnderMpirun) {
+  Json study = tube_optimization("LN_COBYLA", "");
+  study["analyses"] = Json::parse(R"([{"type": "transient", "t_end": 0.05, "output_step": 0.001,
+      "integrator": {"rtol": 1e-9, "atol": 1e-12}}])");
+  study["responses"] = Json::parse(R"({"peak": {"quantity": "peak_displacement",
+      "body": "tip", "direction": [0, 1, 0]}, "mass": {"quantity": "mass"}})");
+  study["study"]["constraints"] = Json::parse(R"([{"response": "peak", "<=": 0.004}])");
+  study["study"]["max_evaluations"] = 30;
+  const fs::path file = write_study("study.json", study);
+  const fs::path history = dir_ / "mpi" / "history.csv";
+  {
+    Process p(BEAMRAIL_MPIEXEC,
+              mpirun_args(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"}), dir_);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (lines_of(history) < 41 && p.alive() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ASSERT_NO_FATAL_FAILURE(kill_whole_job(p));
+  }
+  const size_t kept = lines_of(history);
+  EXPECT_GE(kept, 41u);
+  ASSERT_LT(kept, 121u) << "the job was meant to be killed part-way";
+  EXPECT_FALSE(fs::exists(dir_ / "mpi" / "best.json"));
+  const ProcessResult resumed =
+      run_mpi(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet", "--resume"});
+  ASSERT_TRUE(resumed.exited && resumed.status == 0) << resumed.how << "\n" << resumed.err;
+  const ProcessResult alone =
+      run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
+  ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
+  const auto expected = rows_without_wall(dir_ / "alone" / "history.csv");
+  const auto got = rows_without_wall(history);
+  ASSERT_EQ(expected.size(), 121u) << "4 starts of 30 designs";
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "row " << i;
+  EXPECT_EQ(Json::parse(read_text(dir_ / "mpi" / "best.json")),
+            Json::parse(read_text(dir_ / "alone" / "best.json")));
+  const Json one = Json::parse(read_text(dir_ / "alone" / "summary.json"));
+  const Json many = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  EXPECT_EQ(one["designs_simulated"], 120);
+  EXPECT_EQ(many["designs_simulated"].get<size_t>(), 121 - kept);
+  EXPECT_EQ(many["starts"], one["starts"]);
+  EXPECT_EQ(many["ranks"], 2);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 
 #include "optimizer/batch/start_task.hpp"
 #include "optimizer/batch/wire.hpp"
+#include "optimizer/batch/work_precision.hpp"
 #endif
 
 namespace beamrail {
@@ -41,7 +42,8 @@ int MpiJob::serve() { return 0; }
 std::unique_ptr<BatchExecutor> MpiJob::executor(int threads) {
   return std::make_unique<ThreadExecutor>(threads);
 }
-std::vector<bool> MpiJob::run_tasks(const Study&, int, const std::vector<std::vector<char>>& tasks,
+std::vector<bool> MpiJob::run_tasks(const Study&, int, TaskKind,
+                                    const std::vector<std::vector<char>>& tasks,
                                     const TaskCallbacks& callbacks) {
   // A job of one rank: every task here, in order.
   std::vector<bool> ran(tasks.size(), false);
@@ -54,7 +56,7 @@ std::vector<bool> MpiJob::run_tasks(const Study&, int, const std::vector<std::ve
           if (!callbacks.message(static_cast<long>(i), m)) cancel = true;
         },
         cancel);
-    callbacks.finished(static_cast<long>(i), 0, result);
+    if (!callbacks.finished(static_cast<long>(i), 0, result)) cancel = true;
   }
   return ran;
 }
@@ -248,7 +250,7 @@ std::unique_ptr<BatchExecutor> MpiJob::executor(int threads) {
   return std::make_unique<MpiExecutor>(*this, threads);
 }
 
-std::vector<bool> MpiJob::run_tasks(const Study& study, int threads,
+std::vector<bool> MpiJob::run_tasks(const Study& study, int threads, TaskKind kind,
                                     const std::vector<std::vector<char>>& tasks,
                                     const TaskCallbacks& callbacks) {
   send_study(*this, study, threads);
@@ -275,7 +277,7 @@ std::vector<bool> MpiJob::run_tasks(const Study& study, int threads,
           },
           cancel);
       const std::lock_guard<std::mutex> lock(callback_mutex);
-      callbacks.finished(i, 0, result);
+      if (!callbacks.finished(i, 0, result)) stopped = true, cancel = true;
     }
   });
   std::vector<long> running(size_, -1);  // the task each rank runs
@@ -294,7 +296,10 @@ std::vector<bool> MpiJob::run_tasks(const Study& study, int threads,
         const long i = take();
         if (i < 0) break;
         ran[i] = 1;
-        send(tasks[i], r, kTagTask);
+        Packer p;  // the kind, then the task
+        p.put<int32_t>(static_cast<int32_t>(kind));
+        p.bytes.insert(p.bytes.end(), tasks[i].begin(), tasks[i].end());
+        send(p.bytes, r, kTagTask);
         running[r] = i;
         ++pending;
       }
@@ -312,7 +317,7 @@ std::vector<bool> MpiJob::run_tasks(const Study& study, int threads,
         running[r] = -1;
         --pending;
         const std::lock_guard<std::mutex> lock(callback_mutex);
-        callbacks.finished(i, r, bytes);
+        if (!callbacks.finished(i, r, bytes)) stopped = true;
       }
       backoff.reset();
       continue;
@@ -397,16 +402,23 @@ int MpiJob::serve() {
       } else if (probed.MPI_TAG == kTagTask) {
         if (task.joinable()) task.join();  // rank 0 sends a task once the last one finished
         cancel = false;
-        task = std::thread([&, bytes] {
+        const auto kind = static_cast<TaskKind>(u.get<int32_t>());
+        const std::vector<char> body(bytes.begin() + std::min<size_t>(bytes.size(), 4),
+                                     bytes.end());
+        task = std::thread([&, kind, body] {
           const auto send_message = [&](std::vector<char> m) {
             const std::lock_guard<std::mutex> lock(mutex);
             results.emplace_back(kTagTaskMessage, std::move(m));
             result_ready.notify_one();
           };
-          std::vector<char> result =
-              evaluator ? run_start_task(*evaluator, threads, bytes, send_message, cancel)
-                        : failed_start_task(bytes, "rank " + std::to_string(rank_) +
-                                                       " could not load the study: " + unusable);
+          const std::string why =
+              "rank " + std::to_string(rank_) + " could not load the study: " + unusable;
+          std::vector<char> result;
+          if (kind == TaskKind::kPrecisionRun)
+            result = run_precision_task(study.get(), body, nullptr);
+          else
+            result = evaluator ? run_start_task(*evaluator, threads, body, send_message, cancel)
+                               : failed_start_task(body, why);
           const std::lock_guard<std::mutex> lock(mutex);
           results.emplace_back(kTagTaskDone, std::move(result));
           result_ready.notify_one();

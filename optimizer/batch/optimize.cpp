@@ -199,8 +199,10 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
       r.rank = rank;
       ++run.starts_per_rank[rank];
       collector.finished(r);
+      return !cancel;
     };
-    const std::vector<bool> ran = job->run_tasks(evaluator.study(), run.threads, packed, callbacks);
+    const std::vector<bool> ran = job->run_tasks(evaluator.study(), run.threads,
+                                                 TaskKind::kOptimizationStart, packed, callbacks);
     for (size_t s = 0; s < tasks.size(); ++s)
       if (!ran[s]) run.starts[s] = not_run(problem, static_cast<int>(s) + 1);
   }

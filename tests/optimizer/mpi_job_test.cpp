@@ -350,6 +350,44 @@ TEST_F(MpiRun, AJobKilledWholeResumesUnderMpirunWithNothingLostOrDuplicated) {
   EXPECT_EQ(summary["ranks"], 2);
 }
 
+// A work-precision study (3 methods at 2 tolerances on a short transient of the tube) on 3 ranks:
+// the runs go one at a time to each rank, which measures its run against the reference rank 0
+// sends; work_precision.csv is one process's apart from wall_s.
+TEST_F(MpiRun, AWorkPrecisionStudyOnThreeRanksWritesTheTableOfOneProcess) {
+  Json study = tube_sweep(Json::parse(R"({"type": "work_precision",
+      "methods": [{"method": "bdf"}, {"method": "dirk"},
+                  {"method": "erk", "table": "VERNER_8_5_6"}],
+      "rtols": [1e-4, 1e-7], "target_error": 1e-5})"));
+  study["analyses"] = Json::parse(R"([{"type": "transient", "t_end": 0.02, "output_step": 2e-4}])");
+  study.erase("responses");
+  const fs::path file = write_study("study.json", study);
+  const ProcessResult alone = run_alone({"run", file.string(), "-o", "alone", "--quiet"});
+  ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
+  const ProcessResult mpi = run_mpi(3, {"run", file.string(), "-o", "mpi", "--quiet"});
+  ASSERT_TRUE(mpi.exited && mpi.status == 0) << mpi.how << "\n" << mpi.out << mpi.err;
+  EXPECT_EQ(mpi.err.find("rank 0 alone"), std::string::npos) << mpi.err;
+  const auto expected = rows_without_wall(dir_ / "alone" / "work_precision.csv");
+  const auto got = rows_without_wall(dir_ / "mpi" / "work_precision.csv");
+  ASSERT_EQ(expected.size(), 7u);
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "row " << i;
+  const Json one = Json::parse(read_text(dir_ / "alone" / "summary.json"));
+  const Json many = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  EXPECT_EQ(one["ranks"], 1);
+  EXPECT_FALSE(one.contains("runs_per_rank"));
+  EXPECT_EQ(many["ranks"], 3);
+  EXPECT_EQ(many["status"], "ok");
+  EXPECT_EQ(many["runs"], 6);
+  EXPECT_EQ(many["reference"]["steps"], one["reference"]["steps"]);
+  // Ranks 1 and 2 get a run each before any run can end; rank 0 runs what is left.
+  ASSERT_EQ(many["runs_per_rank"].size(), 3u);
+  EXPECT_GE(many["runs_per_rank"][1].get<long>(), 1);
+  EXPECT_GE(many["runs_per_rank"][2].get<long>(), 1);
+  EXPECT_EQ(many["runs_per_rank"][0].get<long>() + many["runs_per_rank"][1].get<long>() +
+                many["runs_per_rank"][2].get<long>(),
+            6);
+}
+
 // The tube cantilever as an optimization: the lightest tube whose first frequency is at least
 // 25 Hz and whose tip deflects at most 5 mm, from 4 starts (Latin-hypercube points). A wall
 // thicker than the tube's radius is an invalid design: a row of the history with its status.

@@ -146,7 +146,10 @@ int check(const RunArguments& args) {
 
 // The command that runs the study again into the same folder.
 std::string command_line(const RunArguments& args, const std::filesystem::path& out) {
-  std::string c = "beamrail run " + args.study + " -o " + out.string();
+  // Under mpirun, as many ranks again (a scheduler's launcher may say so in its own way).
+  const MpiJob* job = mpi_job();
+  std::string c = job && job->size() > 1 ? "mpirun -n " + std::to_string(job->size()) + " " : "";
+  c += "beamrail run " + args.study + " -o " + out.string();
   if (args.threads > 0) c += " -j " + std::to_string(args.threads);
   return c;
 }

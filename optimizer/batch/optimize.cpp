@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include "core/analysis/stop_request.hpp"
+#include "optimizer/batch/executor.hpp"
 #include "optimizer/batch/mpi_job.hpp"
 #include "optimizer/batch/progress.hpp"
 #include "optimizer/batch/start_task.hpp"
@@ -139,6 +140,10 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
                                             : problem.exact_gradients()     ? n_variables
                                                                             : 2 * n_variables + 1);
   run.ranks = spread ? job->size() : 1;
+  // Under mpirun the ranks run whole starts, or with fewer starts than ranks and difference
+  // gradients, the points of each gradient.
+  const bool by_designs = spread && n_starts < job->size() && needs_gradient(plan.algorithm) &&
+                          !problem.exact_gradients();
   run.threads =
       spread ? (settings.threads > 0 ? settings.threads : 1) : batch_threads(settings, at_once);
   omp_set_num_threads(run.threads);  // the sensitivities' parallel loops
@@ -167,6 +172,17 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
           run_start(problem, evaluator, tasks[s], cache, run.threads, collector, cancel);
       collector.finished(run.starts[s]);
     }
+  } else if (by_designs) {
+    // Fewer starts than ranks, each call of NLopt asking for the points of a difference gradient:
+    // the starts run one after another here, and the designs of each call go to the ranks.
+    const std::unique_ptr<BatchExecutor> designs = job->executor(run.threads);
+    for (int s = 0; s < n_starts; ++s) {
+      run.starts[s] = run_start(problem, evaluator, tasks[s], cache, run.threads, collector, cancel,
+                                designs.get());
+      collector.finished(run.starts[s]);
+    }
+    run.designs_per_rank = designs->stats().designs_per_rank;
+    run.scheduler_seconds = designs->stats().scheduler_seconds;
   } else {
     // Each start goes whole to a rank with the designs it may replay: its rows of history.csv,
     // and the first start the design evaluated above.

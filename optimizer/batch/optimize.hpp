@@ -1,7 +1,8 @@
 // Design optimization with NLopt: any algorithm by name, objective (minimize, maximize, or
 // least-squares targets), inequality constraints on responses, finite-difference gradients
 // evaluated in parallel, several starts from Latin-hypercube points, run by the threads of this
-// process or spread over the ranks of an MPI job (one start at a time per rank), and a history
+// process or spread over the ranks of an MPI job (one start at a time per rank; with fewer starts
+// than ranks and difference gradients, the points of each gradient over the ranks), and a history
 // that doubles as a cache so that an interrupted run resumes by replaying its evaluations.
 //
 // optimize() computes and hands every row to a sink; output/optimization_report.hpp writes the
@@ -32,7 +33,10 @@ struct OptimizationRun {
   std::vector<double> constraint_scales;
   EvaluationCost cost;  // of every design evaluated
   int ranks = 1, threads = 1;
-  std::vector<long> starts_per_rank;  // under mpirun
+  // Under mpirun: the starts each rank ran, or (the ranks evaluating the points of each gradient)
+  // the designs each rank evaluated and rank 0's CPU time spent scheduling them.
+  std::vector<long> starts_per_rank, designs_per_rank;
+  double scheduler_seconds = 0.0;
   double wall_seconds = 0.0;
 };
 

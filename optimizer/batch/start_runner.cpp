@@ -74,7 +74,7 @@ class StartRun {
  public:
   StartRun(const OptimizationProblem& problem, const DesignEvaluator& evaluator,
            const StartTask& task, DesignCache& cache, int threads, StartSink& sink,
-           const std::atomic<bool>& cancel)
+           const std::atomic<bool>& cancel, BatchExecutor* designs)
       : problem_(problem),
         plan_(problem.plan()),
         variables_(problem.variables()),
@@ -83,7 +83,8 @@ class StartRun {
         cache_(cache),
         threads_(std::max(1, threads)),
         sink_(sink),
-        cancel_(cancel) {
+        cancel_(cancel),
+        designs_(designs) {
     result_.index = task.index;
   }
 
@@ -126,6 +127,7 @@ class StartRun {
   int threads_;
   StartSink& sink_;
   const std::atomic<bool>& cancel_;
+  BatchExecutor* designs_;  // null: the start's threads evaluate its designs
   // Distinct designs of this start -> evaluation number: its rows of history.csv, what its design
   // budget (max_evaluations) counts.
   std::map<Design, int> numbers_;
@@ -173,22 +175,46 @@ std::optional<std::vector<DesignOutcome>> StartRun::outcomes(const std::vector<D
   const long n = static_cast<long>(xs.size());
   const int threads = static_cast<int>(std::min<long>(threads_, n));
   EvaluationCost cost;  // of this call's designs, under the critical section below
+  if (designs_ && parallel && !sensitivities) {
+    // The new designs go to the executor (the ranks of an MPI job) and come back in any order.
+    std::vector<long> at;
+    std::vector<Design> batch;
+    for (long i = 0; i < n; ++i)
+      if (!known[i]) at.push_back(i), batch.push_back(xs[i]);
+    std::vector<char> got(at.size(), 0);
+    if (!batch.empty() && !must_stop())
+      designs_->evaluate(evaluator_, batch, [&](long k, const DesignOutcome& o) {
+        out[at[k]] = o;
+        got[k] = 1;
+        if (o.status != Status::kInterrupted) {
+          ++cost.simulated;
+          if (o.status != Status::kOk) ++cost.failures;
+        }
+        return !must_stop();
+      });
+    for (size_t k = 0; k < at.size(); ++k)
+      if (!got[k]) {  // not started: a stop
+        out[at[k]].status = Status::kInterrupted;
+        out[at[k]].responses.assign(problem_.study().responses.size(), kNaN);
+      }
+  } else {
 #pragma omp parallel for schedule(dynamic, 1) if (parallel && n > 1) num_threads(threads)
-  for (long i = 0; i < n; ++i)
-    if (!known[i]) {
-      if (must_stop()) {
-        out[i].status = Status::kInterrupted;  // not evaluated
-        out[i].responses.assign(problem_.study().responses.size(), kNaN);
-        continue;
-      }
-      out[i] = evaluator_.evaluate(xs[i], sensitivities ? &derivatives[i] : nullptr);
-      if (out[i].status == Status::kInterrupted) continue;
+    for (long i = 0; i < n; ++i)
+      if (!known[i]) {
+        if (must_stop()) {
+          out[i].status = Status::kInterrupted;  // not evaluated
+          out[i].responses.assign(problem_.study().responses.size(), kNaN);
+          continue;
+        }
+        out[i] = evaluator_.evaluate(xs[i], sensitivities ? &derivatives[i] : nullptr);
+        if (out[i].status == Status::kInterrupted) continue;
 #pragma omp critical(beamrail_start_cost)
-      {
-        ++cost.simulated;
-        if (out[i].status != Status::kOk) ++cost.failures;
+        {
+          ++cost.simulated;
+          if (out[i].status != Status::kOk) ++cost.failures;
+        }
       }
-    }
+  }
   for (size_t i = 0; i < xs.size(); ++i)
     if (copy_of[i] >= 0) out[i] = out[copy_of[i]];
   for (size_t i = 0; i < xs.size(); ++i) {
@@ -387,9 +413,9 @@ StartResult StartRun::run() {
 
 StartResult run_start(const OptimizationProblem& problem, const DesignEvaluator& evaluator,
                       const StartTask& task, DesignCache& cache, int threads, StartSink& sink,
-                      const std::atomic<bool>& cancel) {
+                      const std::atomic<bool>& cancel, BatchExecutor* designs) {
   try {
-    StartRun run(problem, evaluator, task, cache, threads, sink, cancel);
+    StartRun run(problem, evaluator, task, cache, threads, sink, cancel, designs);
     return run.run();
   } catch (const std::exception& e) {
     StartResult r;

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "optimizer/batch/executor.hpp"
 #include "optimizer/batch/optimization_problem.hpp"
 
 namespace beamrail {
@@ -93,12 +94,13 @@ struct StartTask {
   std::vector<double> constraint_scales;
 };
 
-// Runs a start with `threads` threads for the designs NLopt asks for at once. Stops when a stop
-// is requested (core/analysis/stop_request.hpp) or `cancel` is set: a design cut short is
-// neither cached nor recorded. Never throws.
+// Runs a start with `threads` threads for the designs NLopt asks for at once, or with `designs`
+// for them when given (the ranks of an MPI job; designs evaluated with their derivatives stay
+// here). Stops when a stop is requested (core/analysis/stop_request.hpp) or `cancel` is set: a
+// design cut short is neither cached nor recorded. Never throws.
 StartResult run_start(const OptimizationProblem& problem, const DesignEvaluator& evaluator,
                       const StartTask& task, DesignCache& cache, int threads, StartSink& sink,
-                      const std::atomic<bool>& cancel);
+                      const std::atomic<bool>& cancel, BatchExecutor* designs = nullptr);
 
 // Evaluates x into the cache unless it is there (with its derivatives for exact gradients; they
 // go to the sink), numbered in no start: the design the constraints' scales come from.

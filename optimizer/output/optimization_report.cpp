@@ -344,7 +344,11 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
   s["designs_in_history"] = records_.size();
   s["ranks"] = run.ranks;
   s["threads"] = run.threads;
-  if (run.ranks > 1) s["starts_per_rank"] = run.starts_per_rank;
+  if (!run.starts_per_rank.empty()) s["starts_per_rank"] = run.starts_per_rank;
+  if (!run.designs_per_rank.empty()) {
+    s["designs_per_rank"] = run.designs_per_rank;
+    s["scheduler_seconds"] = run.scheduler_seconds;
+  }
   s["wall_seconds"] = wall;
   s["evaluations_per_second"] = wall > 0 ? static_cast<double>(cost.simulated) / wall : 0.0;
   s["model"] = model_summary(study_.model);

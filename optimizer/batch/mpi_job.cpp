@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 
+#include "core/analysis/stop_request.hpp"
 #include "optimizer/batch/executor.hpp"
 
 #ifdef BEAMRAIL_MPI
@@ -19,7 +20,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/analysis/stop_request.hpp"
+#include "optimizer/batch/start_task.hpp"
+#include "optimizer/batch/wire.hpp"
+#include "optimizer/batch/work_precision.hpp"
 #endif
 
 namespace beamrail {
@@ -39,6 +42,24 @@ int MpiJob::serve() { return 0; }
 std::unique_ptr<BatchExecutor> MpiJob::executor(int threads) {
   return std::make_unique<ThreadExecutor>(threads);
 }
+std::vector<bool> MpiJob::run_tasks(const Study&, int, TaskKind,
+                                    const std::vector<std::vector<char>>& tasks,
+                                    const TaskCallbacks& callbacks) {
+  // A job of one rank: every task here, in order.
+  std::vector<bool> ran(tasks.size(), false);
+  std::atomic<bool> cancel(false);
+  for (size_t i = 0; i < tasks.size() && !cancel && !stop_requested(); ++i) {
+    ran[i] = true;
+    const std::vector<char> result = callbacks.run_here(
+        tasks[i],
+        [&](std::vector<char> m) {
+          if (!callbacks.message(static_cast<long>(i), m)) cancel = true;
+        },
+        cancel);
+    if (!callbacks.finished(static_cast<long>(i), 0, result)) cancel = true;
+  }
+  return ran;
+}
 
 #else
 
@@ -46,86 +67,22 @@ bool mpi_available() { return true; }
 
 namespace {
 
-// Message tags: rank 0 sends the study, designs and the stop; the others send outcomes.
-constexpr int kTagStudy = 1, kTagWork = 2, kTagResult = 3, kTagStop = 4;
-
-// Messages are byte strings: numbers in the machine's own representation (every rank of a job
-// runs the same binary), strings as a length and their bytes.
-class Packer {
- public:
-  template <typename T>
-  void put(T value) {
-    append(&value, sizeof(T));
-  }
-  void put_string(const std::string& s) {
-    put<int64_t>(static_cast<int64_t>(s.size()));
-    append(s.data(), s.size());
-  }
-  void put_doubles(const std::vector<double>& v) {
-    put<int64_t>(static_cast<int64_t>(v.size()));
-    for (double x : v) put(x);
-  }
-  std::vector<char> bytes;
-
- private:
-  void append(const void* data, size_t n) {
-    if (n == 0) return;
-    const size_t at = bytes.size();
-    bytes.resize(at + n);
-    std::memcpy(bytes.data() + at, data, n);
-  }
-};
-
-class Unpacker {
- public:
-  explicit Unpacker(const std::vector<char>& bytes) : bytes_(bytes) {}
-  template <typename T>
-  T get() {
-    T value{};
-    if (at_ + sizeof(T) <= bytes_.size()) std::memcpy(&value, bytes_.data() + at_, sizeof(T));
-    at_ += sizeof(T);
-    return value;
-  }
-  std::string get_string() {
-    const size_t n = static_cast<size_t>(get<int64_t>());
-    if (at_ + n > bytes_.size()) return {};
-    std::string s(bytes_.data() + at_, n);
-    at_ += n;
-    return s;
-  }
-  std::vector<double> get_doubles() {
-    const size_t n = static_cast<size_t>(get<int64_t>());
-    std::vector<double> v;
-    if (at_ + n * sizeof(double) > bytes_.size()) return v;
-    v.reserve(n);
-    for (size_t i = 0; i < n; ++i) v.push_back(get<double>());
-    return v;
-  }
-
- private:
-  const std::vector<char>& bytes_;
-  size_t at_ = 0;
-};
+// Message tags: rank 0 sends the study, designs, tasks, cancellations and the stop; the others
+// send outcomes, the messages of their tasks and the tasks' results.
+constexpr int kTagStudy = 1, kTagWork = 2, kTagResult = 3, kTagStop = 4, kTagTask = 5,
+              kTagTaskMessage = 6, kTagTaskDone = 7, kTagCancel = 8;
 
 std::vector<char> pack_result(long index, const DesignOutcome& o) {
   Packer p;
   p.put<int64_t>(index);
-  p.put<int32_t>(static_cast<int32_t>(o.status));
-  p.put<int32_t>(o.warnings);
-  p.put<double>(o.wall_seconds);
-  p.put_doubles(o.responses);
-  p.put_string(o.message);
+  p.put_outcome(o);
   return std::move(p.bytes);
 }
 
 long unpack_result(const std::vector<char>& bytes, DesignOutcome* o) {
   Unpacker u(bytes);
   const long index = static_cast<long>(u.get<int64_t>());
-  o->status = static_cast<Status>(u.get<int32_t>());
-  o->warnings = u.get<int32_t>();
-  o->wall_seconds = u.get<double>();
-  o->responses = u.get_doubles();
-  o->message = u.get_string();
+  *o = u.get_outcome();
   return index;
 }
 
@@ -167,6 +124,18 @@ class Backoff {
   std::chrono::microseconds longest_, wait_{10};
 };
 
+// Sends the study to the other ranks, once per job.
+void send_study(MpiJob& job, const Study& study, int threads) {
+  if (job.study_sent) return;
+  Packer p;
+  p.put<int32_t>(threads);
+  p.put_string(study.file);
+  p.put_string(study.directory.string());
+  p.put_string(study.document.dump());
+  for (int r = 1; r < job.size(); ++r) send(p.bytes, r, kTagStudy);
+  job.study_sent = true;
+}
+
 // Rank 0's executor: designs go to the other ranks, `threads` + 1 ahead per rank, and to rank 0's
 // own `threads` threads, in index order as each asks for more.
 class MpiExecutor : public BatchExecutor {
@@ -181,16 +150,7 @@ class MpiExecutor : public BatchExecutor {
     const int size = job_.size();
     stats_.designs_per_rank.resize(size, 0);
     double scheduling = 0.0, polling = 0.0;  // CPU seconds
-    if (!job_.study_sent) {
-      const Study& study = evaluator.study();
-      Packer p;
-      p.put<int32_t>(threads_);
-      p.put_string(study.file);
-      p.put_string(study.directory.string());
-      p.put_string(study.document.dump());
-      for (int r = 1; r < size; ++r) send(p.bytes, r, kTagStudy);
-      job_.study_sent = true;
-    }
+    send_study(job_, evaluator.study(), threads_);
     const long n = static_cast<long>(designs.size());
     std::atomic<long> next(0);
     std::atomic<bool> stopped(false);
@@ -290,16 +250,98 @@ std::unique_ptr<BatchExecutor> MpiJob::executor(int threads) {
   return std::make_unique<MpiExecutor>(*this, threads);
 }
 
+std::vector<bool> MpiJob::run_tasks(const Study& study, int threads, TaskKind kind,
+                                    const std::vector<std::vector<char>>& tasks,
+                                    const TaskCallbacks& callbacks) {
+  send_study(*this, study, threads);
+  const long n = static_cast<long>(tasks.size());
+  std::vector<char> ran(tasks.size(), 0);
+  std::mutex callback_mutex;  // the callbacks are called one at a time
+  std::atomic<bool> stopped(false), cancel(false);
+  std::atomic<long> next(0);
+  // The next task to start, -1 when none is left or the batch stops.
+  auto take = [&]() -> long {
+    if (stopped || stop_requested()) return -1;
+    const long i = next++;
+    return i < n ? i : -1;
+  };
+  // Rank 0 runs tasks too, one at a time, beside this thread's scheduling.
+  std::thread here([&] {
+    for (long i = take(); i >= 0; i = take()) {
+      ran[i] = 1;
+      const std::vector<char> result = callbacks.run_here(
+          tasks[i],
+          [&](std::vector<char> m) {
+            const std::lock_guard<std::mutex> lock(callback_mutex);
+            if (!callbacks.message(i, m)) stopped = true, cancel = true;
+          },
+          cancel);
+      const std::lock_guard<std::mutex> lock(callback_mutex);
+      if (!callbacks.finished(i, 0, result)) stopped = true, cancel = true;
+    }
+  });
+  std::vector<long> running(size_, -1);  // the task each rank runs
+  long pending = 0;                      // tasks sent and not finished
+  bool cancel_sent = false;
+  Backoff backoff(std::chrono::microseconds(1000));
+  while (true) {
+    if (!cancel_sent && (stopped || stop_requested())) {
+      cancel = true;
+      for (int r = 1; r < size_; ++r)
+        if (running[r] >= 0) MPI_Send(nullptr, 0, MPI_BYTE, r, kTagCancel, MPI_COMM_WORLD);
+      cancel_sent = true;
+    }
+    for (int r = 1; r < size_ && !cancel_sent; ++r)
+      if (running[r] < 0) {
+        const long i = take();
+        if (i < 0) break;
+        ran[i] = 1;
+        Packer p;  // the kind, then the task
+        p.put<int32_t>(static_cast<int32_t>(kind));
+        p.bytes.insert(p.bytes.end(), tasks[i].begin(), tasks[i].end());
+        send(p.bytes, r, kTagTask);
+        running[r] = i;
+        ++pending;
+      }
+    int found = 0;
+    MPI_Status probed;
+    MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &found, &probed);
+    if (found) {
+      const std::vector<char> bytes = receive(probed);
+      const int r = probed.MPI_SOURCE;
+      if (running[r] >= 0 && probed.MPI_TAG == kTagTaskMessage) {
+        const std::lock_guard<std::mutex> lock(callback_mutex);
+        if (!callbacks.message(running[r], bytes)) stopped = true;
+      } else if (running[r] >= 0 && probed.MPI_TAG == kTagTaskDone) {
+        const long i = running[r];
+        running[r] = -1;
+        --pending;
+        const std::lock_guard<std::mutex> lock(callback_mutex);
+        if (!callbacks.finished(i, r, bytes)) stopped = true;
+      }
+      backoff.reset();
+      continue;
+    }
+    if (pending == 0 && (next >= n || cancel_sent)) break;
+    std::this_thread::sleep_for(backoff.next());
+  }
+  here.join();
+  return std::vector<bool>(ran.begin(), ran.end());
+}
+
 int MpiJob::serve() {
   std::unique_ptr<Study> study;
   std::unique_ptr<DesignEvaluator> evaluator;
   std::string unusable;  // why the study sent could not be loaded (then every design fails)
-  std::deque<std::pair<long, Design> > work;
-  std::vector<std::vector<char> > results;
+  std::deque<std::pair<long, Design>> work;
+  std::vector<std::pair<int, std::vector<char>>> results;  // tag, message
   std::mutex mutex;
   std::condition_variable work_ready, result_ready;
   bool quit = false;
   std::vector<std::thread> pool;
+  int threads = 1;   // per design batch and per task, as rank 0 says
+  std::thread task;  // the task (optimization start) under way, one at a time
+  std::atomic<bool> cancel(false);
   auto evaluate_work = [&] {
     std::unique_lock<std::mutex> lock(mutex);
     while (true) {
@@ -317,19 +359,19 @@ int MpiJob::serve() {
       }
       std::vector<char> bytes = pack_result(index, o);
       lock.lock();
-      results.push_back(std::move(bytes));
+      results.emplace_back(kTagResult, std::move(bytes));
       result_ready.notify_one();
     }
   };
 
   Backoff backoff(std::chrono::microseconds(1000));
   while (true) {
-    std::vector<std::vector<char> > outgoing;
+    std::vector<std::pair<int, std::vector<char>>> outgoing;
     {
       std::unique_lock<std::mutex> lock(mutex);
       outgoing.swap(results);
     }
-    for (const std::vector<char>& bytes : outgoing) send(bytes, 0, kTagResult);
+    for (const auto& [tag, bytes] : outgoing) send(bytes, 0, tag);
     int found = 0;
     MPI_Status probed;
     MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &found, &probed);
@@ -339,7 +381,7 @@ int MpiJob::serve() {
       if (probed.MPI_TAG == kTagStop) break;
       Unpacker u(bytes);
       if (probed.MPI_TAG == kTagStudy) {
-        const int threads = u.get<int32_t>();
+        threads = std::max(1, u.get<int32_t>());
         const std::string file = u.get_string(), directory = u.get_string();
         Diagnostics diag;
         std::optional<Study> loaded;
@@ -356,7 +398,33 @@ int MpiJob::serve() {
                          ? "no design study"
                          : diag.items()[0].pointer + ": " + diag.items()[0].message;
         }
-        for (int t = 0; t < std::max(1, threads); ++t) pool.emplace_back(evaluate_work);
+        for (int t = 0; t < threads; ++t) pool.emplace_back(evaluate_work);
+      } else if (probed.MPI_TAG == kTagTask) {
+        if (task.joinable()) task.join();  // rank 0 sends a task once the last one finished
+        cancel = false;
+        const auto kind = static_cast<TaskKind>(u.get<int32_t>());
+        const std::vector<char> body(bytes.begin() + std::min<size_t>(bytes.size(), 4),
+                                     bytes.end());
+        task = std::thread([&, kind, body] {
+          const auto send_message = [&](std::vector<char> m) {
+            const std::lock_guard<std::mutex> lock(mutex);
+            results.emplace_back(kTagTaskMessage, std::move(m));
+            result_ready.notify_one();
+          };
+          const std::string why =
+              "rank " + std::to_string(rank_) + " could not load the study: " + unusable;
+          std::vector<char> result;
+          if (kind == TaskKind::kPrecisionRun)
+            result = run_precision_task(study.get(), body, nullptr);
+          else
+            result = evaluator ? run_start_task(*evaluator, threads, body, send_message, cancel)
+                               : failed_start_task(body, why);
+          const std::lock_guard<std::mutex> lock(mutex);
+          results.emplace_back(kTagTaskDone, std::move(result));
+          result_ready.notify_one();
+        });
+      } else if (probed.MPI_TAG == kTagCancel) {
+        cancel = true;
       } else if (probed.MPI_TAG == kTagWork) {
         const long index = static_cast<long>(u.get<int64_t>());
         Design x = u.get_doubles();
@@ -375,6 +443,7 @@ int MpiJob::serve() {
     work_ready.notify_all();
   }
   for (std::thread& t : pool) t.join();
+  if (task.joinable()) task.join();
   return 0;
 }
 

@@ -1,15 +1,16 @@
 #include "optimizer/batch/work_precision.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <exception>
 #include <iostream>
 #include <limits>
+#include <mutex>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/cli/interruption.hpp"
-#include "optimizer/output/summary.hpp"
-#include "optimizer/output/tables.hpp"
-#include "optimizer/output/version.hpp"
-#include "optimizer/run/trajectory.hpp"
+#include "optimizer/batch/mpi_job.hpp"
+#include "optimizer/batch/wire.hpp"
+#include "optimizer/output/work_precision_report.hpp"
 
 namespace beamrail {
 namespace {
@@ -29,141 +30,208 @@ RunRecord run(const Model& model, TransientOptions options) {
   return r;
 }
 
-}  // namespace
-
-int run_work_precision(const Study& study, const RunSettings& settings) {
-  const WorkPrecisionPlan& plan = study.design->work_precision;
+// The study's transient analysis as every run starts it: no time budget of its own.
+TransientOptions base_options(const Study& study) {
   const AnalysisSpec& analysis =
       study.analyses[find_analysis(study, AnalysisSpec::Type::kTransient)];
   TransientOptions base = analysis.transient;
   base.max_seconds = 0.0;
-  SparseStructureCache structures;  // every run integrates the same model
-  base.structure_cache = &structures;
+  return base;
+}
 
-  TransientOptions reference_options = base;
-  reference_options.integrator = plan.reference;
-  nlohmann::json summary;
-  summary["study"] = study.name;
-  summary["file"] = study.file;
-  summary["beamrail_version"] = kVersion;
-  summary["type"] = "work_precision";
-  summary["warnings"] = study.input_warnings;
-  // The summary of a run that ends early (status, message); false when it cannot be written.
-  const auto write_summary = [&](const std::string& status, const std::string& message) {
-    summary["status"] = status;
-    summary["message"] = message;
-    summary["model"] = model_summary(study.model);
-    std::string error;
-    if (write_file_atomically(settings.output / "summary.json", summary.dump(2) + "\n", &error))
-      return true;
-    std::cerr << "beamrail: " << error << "\n";
-    return false;
-  };
+void put_trajectory(Packer& p, const Trajectory& t) {
+  p.put<int64_t>(static_cast<int64_t>(t.bodies.size()));
+  for (int b : t.bodies) p.put<int32_t>(b);
+  p.put_doubles(t.times);
+  std::vector<double> xyz;
+  xyz.reserve(3 * t.positions.size());
+  for (const Vec3& v : t.positions) xyz.insert(xyz.end(), {v.x(), v.y(), v.z()});
+  p.put_doubles(xyz);
+}
 
-  const RunRecord reference = run(study.model, reference_options);
-  if (reference.result.interrupted) {
-    const int signal = stop_requested();
-    write_summary("interrupted", "interrupted by " + signal_name(signal) + " in the reference run");
-    std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal)
-              << " in the reference run; nothing to keep\n";
-    return interrupted_exit_status(signal);
-  }
-  if (!reference.result.ok) {
-    write_summary("failed", "the reference run failed: " + reference.result.message);
-    std::cerr << "beamrail: the reference run failed: " << reference.result.message << "\n";
-    return 1;
-  }
+Trajectory get_trajectory(Unpacker& u) {
+  Trajectory t;
+  const long n = static_cast<long>(u.get<int64_t>());
+  for (long i = 0; i < n && i < (1L << 30); ++i) t.bodies.push_back(u.get<int32_t>());
+  t.times = u.get_doubles();
+  const std::vector<double> xyz = u.get_doubles();
+  for (size_t i = 0; i + 2 < xyz.size(); i += 3)
+    t.positions.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
+  return t;
+}
 
-  CsvWriter table;
-  std::string error;
-  if (!table.open(settings.output / "work_precision.csv",
-                  {"method", "rtol", "atol", "error", "wall_s", "steps", "rhs_evals", "jac_evals",
-                   "linear_solver", "status"},
-                  &error, true)) {
-    write_summary("failed", error);
-    std::cerr << "beamrail: " << error << "\n";
-    return 1;
+std::vector<char> pack_run(const PrecisionRun& r) {
+  Packer p;
+  p.put<int64_t>(r.index);
+  p.put_string(r.method);
+  p.put<double>(r.rtol);
+  p.put<double>(r.atol);
+  p.put<double>(r.error);
+  p.put<double>(r.stats.wall_seconds);
+  p.put<int64_t>(r.stats.steps);
+  p.put<int64_t>(r.stats.rhs_evaluations);
+  p.put<int64_t>(r.stats.jacobian_evaluations);
+  p.put_string(r.linear_solver);
+  p.put<int32_t>((r.ok ? 1 : 0) | (r.timed_out ? 2 : 0) | (r.interrupted ? 4 : 0));
+  return std::move(p.bytes);
+}
+
+}  // namespace
+
+PrecisionRun measure_run(const Study& study, long index, const Trajectory& reference,
+                         SparseStructureCache* structures) {
+  const WorkPrecisionPlan& plan = study.design->work_precision;
+  const size_t n_rtols = plan.rtols.size();
+  const WorkPrecisionPlan::Method& method = plan.methods.at(static_cast<size_t>(index) / n_rtols);
+  const double rtol = plan.rtols.at(static_cast<size_t>(index) % n_rtols);
+  TransientOptions options = base_options(study);
+  options.structure_cache = structures;
+  options.integrator = method.integrator;
+  options.integrator.rtol = rtol;
+  options.integrator.atol = rtol * plan.atol_scale;
+  options.max_seconds = plan.max_seconds;
+  const RunRecord r = run(study.model, options);
+  PrecisionRun out;
+  out.index = index;
+  out.method = method.label;
+  out.rtol = rtol;
+  out.atol = options.integrator.atol;
+  out.ok = r.result.ok;
+  out.timed_out = r.result.timed_out;
+  out.interrupted = r.result.interrupted;
+  out.error = r.result.ok ? trajectory_error(r.trajectory, reference)
+                          : std::numeric_limits<double>::quiet_NaN();
+  out.stats = r.result.stats;
+  out.linear_solver = r.result.linear_solver;
+  return out;
+}
+
+std::vector<char> pack_precision_task(long index, const Trajectory& reference) {
+  Packer p;
+  p.put<int64_t>(index);
+  put_trajectory(p, reference);
+  return std::move(p.bytes);
+}
+
+std::vector<char> run_precision_task(const Study* study, const std::vector<char>& task,
+                                     SparseStructureCache* structures) {
+  // Every run of a rank integrates the same model: its structure is analysed once.
+  static SparseStructureCache own;
+  Unpacker u(task);
+  const long index = static_cast<long>(u.get<int64_t>());
+  try {
+    if (study && study->design && study->design->type == DesignStudy::Type::kWorkPrecision)
+      return pack_run(
+          measure_run(*study, index, get_trajectory(u), structures ? structures : &own));
+  } catch (const std::exception&) {
   }
-  nlohmann::json best = nullptr;
-  double best_wall = std::numeric_limits<double>::infinity();
-  long runs = 0, failed = 0;
-  const long planned = static_cast<long>(plan.methods.size() * plan.rtols.size());
-  bool interrupted = false;
-  for (const WorkPrecisionPlan::Method& method : plan.methods)
-    for (double rtol : plan.rtols) {
-      if (stop_requested() || !table.good()) break;
-      TransientOptions options = base;
-      options.integrator = method.integrator;
-      options.integrator.rtol = rtol;
-      options.integrator.atol = rtol * plan.atol_scale;
-      options.max_seconds = plan.max_seconds;
-      const RunRecord r = run(study.model, options);
-      if (r.result.interrupted) {
-        interrupted = true;  // not a measurement: no row
+  {
+    PrecisionRun failed;  // what rank 0 reports as a failed run
+    failed.index = index;
+    failed.error = std::numeric_limits<double>::quiet_NaN();
+    return pack_run(failed);
+  }
+}
+
+PrecisionRun unpack_precision_run(const std::vector<char>& bytes) {
+  Unpacker u(bytes);
+  PrecisionRun r;
+  r.index = static_cast<long>(u.get<int64_t>());
+  r.method = u.get_string();
+  r.rtol = u.get<double>();
+  r.atol = u.get<double>();
+  r.error = u.get<double>();
+  r.stats.wall_seconds = u.get<double>();
+  r.stats.steps = static_cast<long>(u.get<int64_t>());
+  r.stats.rhs_evaluations = static_cast<long>(u.get<int64_t>());
+  r.stats.jacobian_evaluations = static_cast<long>(u.get<int64_t>());
+  r.linear_solver = u.get_string();
+  const int32_t flags = u.get<int32_t>();
+  r.ok = flags & 1, r.timed_out = flags & 2, r.interrupted = flags & 4;
+  return r;
+}
+
+PrecisionReference run_reference(const Study& study) {
+  TransientOptions options = base_options(study);
+  PrecisionReference reference;
+  options.structure_cache = reference.structures.get();
+  options.integrator = study.design->work_precision.reference;
+  RunRecord r = run(study.model, options);
+  reference.result = std::move(r.result);
+  reference.trajectory = std::move(r.trajectory);
+  return reference;
+}
+
+WorkPrecisionResult measure_work_precision(const Study& study, const PrecisionReference& reference,
+                                           const std::function<bool(const PrecisionRun&)>& done) {
+  const WorkPrecisionPlan& plan = study.design->work_precision;
+  WorkPrecisionResult result;
+  result.planned = static_cast<long>(plan.methods.size() * plan.rtols.size());
+  SparseStructureCache& structures = *reference.structures;
+  MpiJob* job = mpi_job();
+  if (!job || job->size() < 2) {
+    // One after another, so that timings are not shared with other runs.
+    for (long i = 0; i < result.planned && !stop_requested(); ++i) {
+      const PrecisionRun r = measure_run(study, i, reference.trajectory, &structures);
+      if (r.interrupted) {  // not a measurement
+        result.interrupted = true;
         break;
       }
-      const double e = r.result.ok ? trajectory_error(r.trajectory, reference.trajectory)
-                                   : std::numeric_limits<double>::quiet_NaN();
-      const std::string status = r.result.ok ? "ok" : r.result.timed_out ? "timeout" : "failed";
-      const SolverStats& s = r.result.stats;
-      table.row({method.label, format_number(rtol), format_number(options.integrator.atol),
-                 format_number(e), format_number(s.wall_seconds), std::to_string(s.steps),
-                 std::to_string(s.rhs_evaluations), std::to_string(s.jacobian_evaluations),
-                 r.result.linear_solver, status});
-      if (!table.flush()) break;
-      ++runs;
-      failed += !r.result.ok;
-      if (r.result.ok && e <= plan.target_error && s.wall_seconds < best_wall) {
-        best_wall = s.wall_seconds;
-        best = {{"method", method.label},          {"rtol", rtol},
-                {"atol", options.integrator.atol}, {"error", e},
-                {"wall_seconds", s.wall_seconds},  {"steps", s.steps}};
-      }
-      if (!settings.quiet)
-        std::cerr << method.label << " rtol " << format_number(rtol) << ": error "
-                  << format_number(e) << ", " << s.wall_seconds << " s (" << status << ")\n";
+      result.runs.push_back(r);
+      if (!done(r)) break;
     }
+    return result;
+  }
+  // Over the ranks, one run at a time per rank: each compares its run with the reference sent.
+  result.ranks = job->size();
+  std::vector<std::vector<char>> tasks;
+  for (long i = 0; i < result.planned; ++i)
+    tasks.push_back(pack_precision_task(i, reference.trajectory));
+  TaskCallbacks callbacks;
+  callbacks.run_here =
+      [&](const std::vector<char>& task, const std::function<void(std::vector<char>)>&,
+          const std::atomic<bool>&) { return run_precision_task(&study, task, &structures); };
+  callbacks.message = [](long, const std::vector<char>&) { return true; };
+  result.runs_per_rank.assign(job->size(), 0);
+  callbacks.finished = [&](long, int rank, const std::vector<char>& bytes) {
+    ++result.runs_per_rank[rank];
+    PrecisionRun r = unpack_precision_run(bytes);
+    if (r.method.empty()) {  // a run that could not start on its rank
+      const size_t n_rtols = plan.rtols.size();
+      r.method = plan.methods.at(static_cast<size_t>(r.index) / n_rtols).label;
+      r.rtol = plan.rtols.at(static_cast<size_t>(r.index) % n_rtols);
+      r.atol = r.rtol * plan.atol_scale;
+    }
+    if (r.interrupted) {
+      result.interrupted = true;
+      return false;
+    }
+    result.runs.push_back(r);
+    return done(r);
+  };
+  job->run_tasks(study, 1, TaskKind::kPrecisionRun, tasks, callbacks);
+  std::sort(result.runs.begin(), result.runs.end(),
+            [](const PrecisionRun& a, const PrecisionRun& b) { return a.index < b.index; });
+  return result;
+}
 
-  const int signal = stop_requested();
-  interrupted = interrupted || (signal != 0 && runs < planned);
+int run_work_precision(const Study& study, const RunSettings& settings) {
+  const PrecisionReference reference = run_reference(study);
+  if (!reference.result.ok) return report_no_runs(study, settings, reference, "");
+  WorkPrecisionTable table;
+  std::string error;
+  if (!table.open(settings.output, &error))
+    return report_no_runs(study, settings, reference, error);
+  const WorkPrecisionResult result =
+      measure_work_precision(study, reference, [&](const PrecisionRun& r) {
+        if (!settings.quiet)
+          std::cerr << r.method << " rtol " << format_number(r.rtol) << ": error "
+                    << format_number(r.error) << ", " << r.stats.wall_seconds << " s ("
+                    << r.status() << ")\n";
+        return table.add(r);
+      });
   const bool written = table.commit(&error);
-  summary["runs"] = runs;
-  summary["failed_or_timeout"] = failed;
-  summary["target_error"] = plan.target_error;
-  summary["fastest_within_target"] = best;
-  summary["reference"] = {{"method", method_name(plan.reference.method)},
-                          {"rtol", plan.reference.rtol},
-                          {"atol", plan.reference.atol},
-                          {"wall_seconds", reference.result.stats.wall_seconds},
-                          {"steps", reference.result.stats.steps}};
-  summary["error_measure"] =
-      "largest distance between body centres over the output times, relative to the largest "
-      "distance a body moved in the reference run";
-  if (!written) {
-    write_summary("failed", error);
-    std::cerr << "beamrail: " << error << "\n";
-    return 1;
-  }
-  if (interrupted) {
-    if (!write_summary("interrupted", "interrupted by " + signal_name(signal) + " after " +
-                                          std::to_string(runs) + " of " + std::to_string(planned) +
-                                          " runs"))
-      return 1;
-    std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
-              << runs << " of " << planned << " runs are in "
-              << (settings.output / "work_precision.csv").string()
-              << "; a work-precision study does not resume: run it again to measure them all\n";
-    return interrupted_exit_status(signal);
-  }
-  if (!write_summary("ok", "")) return 1;
-  std::cout << study.name << ": " << runs << " runs (" << failed << " failed or timed out)";
-  if (!best.is_null())
-    std::cout << "; fastest within " << format_number(plan.target_error) << ": "
-              << best["method"].get<std::string>() << " at rtol "
-              << format_number(best["rtol"].get<double>()) << " in "
-              << best["wall_seconds"].get<double>() << " s";
-  std::cout << " -> " << settings.output.string() << "\n";
-  return 0;
+  return report_work_precision(study, settings, reference, result, written ? "" : error);
 }
 
 }  // namespace beamrail

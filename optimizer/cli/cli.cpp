@@ -153,7 +153,10 @@ int check(const RunArguments& args) {
 
 // The command that runs the study again into the same folder.
 std::string command_line(const RunArguments& args, const std::filesystem::path& out) {
-  std::string c = "beamrail run " + args.study + " -o " + out.string();
+  // Under mpirun, as many ranks again (a scheduler's launcher may say so in its own way).
+  const MpiJob* job = mpi_job();
+  std::string c = job && job->size() > 1 ? "mpirun -n " + std::to_string(job->size()) + " " : "";
+  c += "beamrail run " + args.study + " -o " + out.string();
   if (args.threads > 0) c += " -j " + std::to_string(args.threads);
   return c;
 }
@@ -248,11 +251,13 @@ int run(const RunArguments& args) {
   }
 
   const StopOnSignals signals;
-  // Under mpirun the other ranks evaluate a sweep's designs; anything else runs here alone.
-  const bool sweep = study->design && study->design->type == DesignStudy::Type::kSweep;
-  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !sweep)
-    std::cerr << "beamrail: only sweeps spread over MPI ranks so far; this study runs on rank 0 "
-                 "alone (the other "
+  // Under mpirun the other ranks evaluate a sweep's designs, run an optimization's starts and a
+  // work-precision study's runs; anything else runs here alone.
+  const bool spread = study->design && study->design->type != DesignStudy::Type::kSensitivity;
+  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !spread)
+    std::cerr << "beamrail: only sweeps, optimizations and work-precision studies spread over MPI "
+                 "ranks so far; this "
+                 "study runs on rank 0 alone (the other "
               << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {

@@ -85,6 +85,7 @@ class Process {
   }
 
   bool started() const { return pid_ > 0; }
+  pid_t pid() const { return pid_; }
   bool running() const { return pid_ > 0 && !done_; }
 
   // True while the process has not ended (reaps it when it has).

@@ -1,9 +1,10 @@
 #include "core/scene/auto_segments.hpp"
 
-#include <Eigen/Dense>
-#include <Eigen/SparseCore>
 #include <Spectra/MatOp/SparseSymShiftSolve.h>
 #include <Spectra/SymEigsShiftSolver.h>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -27,9 +28,9 @@ std::vector<double> cantilever_bending_frequencies(const UniformBeam& beam, int 
     d(2 * (i - 1) + 1) = 1.0 / std::sqrt(share * j);
   }
   Eigen::Matrix4d ke;
-  ke << 12, 6 * l, -12, 6 * l,  //
+  ke << 12, 6 * l, -12, 6 * l,              //
       6 * l, 4 * l * l, -6 * l, 2 * l * l,  //
-      -12, -6 * l, 12, -6 * l,  //
+      -12, -6 * l, 12, -6 * l,              //
       6 * l, 2 * l * l, -6 * l, 4 * l * l;
   ke *= ei / (l * l * l);
   std::vector<Eigen::Triplet<double>> entries;

@@ -51,11 +51,6 @@ inline constexpr int kModalIntegratorMaxDofs = 1200;
 // [rad].
 inline constexpr double kModalIntegratorMaxRotation = 1.0;
 
-// g_m(x) = sum_j (-x)^j / (2j + m)!, m = 0..4, at x = lambda tau^2: the phi functions of a mode
-// block B = [[0, 1], [-lambda, 0]] are phi_k(tau B) = g_k I + tau g_{k+1} B (B^2 = -lambda I).
-// Any sign of lambda (negative: an unstable mode).
-std::array<double, 5> oscillator_g(double x);
-
 // The flag of a run stopped because a body turned more than the rotation limit from the
 // orientation it is linearized about (y and t then hold the last accepted state).
 inline constexpr int kModalTooFar = -20;

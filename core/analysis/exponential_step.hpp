@@ -1,0 +1,64 @@
+// The step of the modal integrator (core/analysis/modal_integrator.hpp): functions of the 2 x 2
+// mode blocks B_i = [[0, 1], [-lambda_i, 0]] and the coefficient functions of the stiff-order-4
+// exponential Runge-Kutta method of Hochbruck and Ostermann (2005) with its embedded solutions.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <initializer_list>
+#include <utility>
+
+namespace beamrail {
+
+// g_m(x) = sum_j (-x)^j / (2j + m)!, m = 0..4, at x = lambda tau^2: the phi functions of a mode
+// block B = [[0, 1], [-lambda, 0]] are phi_k(tau B) = g_k I + tau g_{k+1} B (B^2 = -lambda I).
+// Any sign of lambda (negative: an unstable mode).
+std::array<double, 5> oscillator_g(double x);
+
+// Per mode a row: (eta, nu), or (x, u) in the physical basis.
+using ModeBlock = Eigen::Matrix<double, Eigen::Dynamic, 2>;
+
+// A function of the mode blocks B_i = [[0, 1], [-lambda_i, 0]], f(B_i) = alpha_i I + beta_i B_i.
+struct ModeFunction {
+  Eigen::ArrayXd alpha, beta;
+  ModeFunction() = default;
+  explicit ModeFunction(Eigen::Index n) : alpha(Eigen::ArrayXd::Zero(n)), beta(alpha) {}
+  bool empty() const { return alpha.size() == 0; }  // a zero coefficient: skipped
+  ModeFunction& add(double s, const ModeFunction& f) {
+    alpha += s * f.alpha;
+    beta += s * f.beta;
+    return *this;
+  }
+};
+
+// The sum of s f over the terms (s, f).
+ModeFunction combine(std::initializer_list<std::pair<double, const ModeFunction*>> terms);
+
+// out += f(B) z, per mode (inline: every stage of every step calls it).
+inline void apply_add(const ModeFunction& f, const Eigen::ArrayXd& lambda, const ModeBlock& z,
+                      ModeBlock& out) {
+  const auto a = z.col(0).array(), b = z.col(1).array();
+  out.col(0).array() += f.alpha * a + f.beta * b;
+  out.col(1).array() += f.alpha * b - f.beta * lambda * a;
+}
+
+// The coefficient functions of one step of size h of the stiff-order-4 exponential Runge-Kutta
+// method (5 stages, c = 0, 1/2, 1/2, 1, 1/2):
+//   Z_i = E(c_i h) z + h sum_j a_ij N_j,   z+ = E(h) z + h sum_j b_j N_j.
+struct StepFunctions {
+  static constexpr int kStages = 5;
+  static constexpr double c[kStages] = {0.0, 0.5, 0.5, 1.0, 0.5};
+  double h = 0.0;
+  ModeFunction e_half, e_full;
+  ModeFunction a[kStages][kStages];
+  ModeFunction b[kStages];
+  ModeFunction low[2];  // the embedded order-2 method: b1 = phi1 - 2 phi2, b2 = 2 phi2
+  // The embedded third-order solution takes stage 3 (c = 1/2, local order 3) where the
+  // fourth-order one takes stage 5 with the same weight b5 = 4 phi2 - 8 phi3: the two differ by
+  // h b5 (N5 - N3), O(h^4).
+
+  // The functions of step `step` for the modes' eigenvalues lambda.
+  void compute(double step, const Eigen::ArrayXd& lambda);
+};
+
+}  // namespace beamrail

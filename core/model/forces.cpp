@@ -2,6 +2,7 @@
 
 #include "core/model/beam.hpp"
 #include "core/model/element_tangent.hpp"
+#include "core/model/joint.hpp"
 #include "core/model/rail.hpp"
 
 namespace beamrail {
@@ -88,6 +89,9 @@ void compute_wrenches(const Model& model, Data& data, double t, double load_fact
     data.rail_floored[r] = floored;
     if (floored) data.rail_floored_ever[r] = 1;
   }
+  for (const Joint& j : model.joints)
+    energy += joint_wrenches(j, data.pose[j.body1], data.pose[j.body2], data.wrench[j.body1],
+                             data.wrench[j.body2]);
   data.elastic_energy = energy;
   data.out_of_range = out;
   ++data.n_wrench_evaluations;
@@ -151,6 +155,16 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
     if (with_velocity)
       scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
               data.damping);
+  }
+  // Joints: forward AD through the whole kernel (they have no velocity terms).
+  for (size_t n = 0; n < model.joints.size(); ++n) {
+    const Joint& j = model.joints[n];
+    const auto kernel = [&j](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
+                             Vec6T<Ad12>& w2) { joint_wrenches(j, b1, b2, w1, w2); };
+    scatter(model.pattern.joint_blocks[n],
+            element_jacobian(seed_configuration(data.pose[j.body1], 0),
+                             seed_configuration(data.pose[j.body2], 6), kernel),
+            data.stiffness);
   }
   ++data.n_tangent_evaluations;
 }

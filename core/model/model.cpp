@@ -45,6 +45,8 @@ void Model::finalize() {
   for (const Rail& e : rails)
     pattern.rail_blocks.push_back(
         couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
+  for (const Joint& e : joints)
+    pattern.joint_blocks.push_back(couple(bodies, index, pattern.blocks, e.body1, e.body2));
   pattern.transposed.resize(pattern.blocks.size());
   for (size_t b = 0; b < pattern.blocks.size(); ++b)
     pattern.transposed[b] = index.at({pattern.blocks[b].col, pattern.blocks[b].row});

@@ -85,6 +85,24 @@ struct Rail {
   double density = 0.0;
 };
 
+enum class JointType { kSpherical, kRevolute, kFixed };
+
+// A joint between two bodies, modelled as a stiff penalty element (core/model/joint.hpp,
+// docs/model.md "Joints"): spherical keeps the two bodies' joint points together, revolute also
+// keeps their axes aligned, fixed also keeps their frames aligned.
+struct Joint {
+  std::string name;
+  JointType type = JointType::kSpherical;
+  int body1 = 0, body2 = 0;
+  Vec3 r1 = Vec3::Zero(), r2 = Vec3::Zero();  // the joint point in body axes, from the centres [m]
+  // The joint frame in each body's axes (equal in global axes initially); column 0 is the axis.
+  Mat3 frame1 = Mat3::Identity(), frame2 = Mat3::Identity();
+  Vec3 centre_offset = Vec3::Zero();  // c2 - c1 of the bodies' reference centres, global [m]
+  double relative_compliance = 1e-6;  // the penalty stiffness is the scene's scale over this
+  double k_force = 0.0;               // [N/m]
+  double k_moment = 0.0;              // [N m/rad]
+};
+
 enum class LoadKind { kForce, kTorque };
 
 struct Load {
@@ -110,6 +128,7 @@ struct BlockPattern {
   // a fixed body: [0] = (1,1), [1] = (1,2), [2] = (2,1), [3] = (2,2).
   std::vector<std::array<int, 4>> beam_blocks;
   std::vector<std::array<int, 4>> rail_blocks;
+  std::vector<std::array<int, 4>> joint_blocks;
   std::vector<int> transposed;  // per block, the index of the block (col, row)
 };
 
@@ -128,6 +147,7 @@ struct Model {
   std::vector<Body> bodies;  // [0] is ground
   std::vector<Beam> beams;
   std::vector<Rail> rails;
+  std::vector<Joint> joints;
   std::vector<Load> loads;
   Vec3 gravity = Vec3::Zero();                 // [m/s^2]
   std::vector<std::string> load_cases;         // the names loads give as their case, in scene order
@@ -140,8 +160,8 @@ struct Model {
 
   int n_free() const { return static_cast<int>(free_bodies.size()); }
 
-  // Fills free_bodies, n_states, n_dofs and pattern from bodies, beams and rails. Called once by
-  // the scene loader after the element arrays are final.
+  // Fills free_bodies, n_states, n_dofs and pattern from bodies, beams, rails and joints. Called
+  // once by the scene loader after the element arrays are final.
   void finalize();
 };
 
@@ -154,6 +174,7 @@ Model with_loads(const Model& model, Keep&& keep, bool gravity) {
   out.bodies = model.bodies;
   out.beams = model.beams;
   out.rails = model.rails;
+  out.joints = model.joints;
   for (const Load& load : model.loads)
     if (keep(load)) out.loads.push_back(load);
   out.gravity = gravity ? model.gravity : Vec3::Zero();

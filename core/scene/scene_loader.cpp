@@ -5,10 +5,12 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
 
+#include "core/model/joint.hpp"
 #include "core/model/rotation.hpp"
 #include "core/scene/auto_segments.hpp"
 #include "core/scene/scene_specs.hpp"
@@ -234,6 +236,66 @@ void choose_auto_segments(SceneSpecs& specs, const SegmentationTarget& target,
   }
 }
 
+// The joints of the scene, with their penalty stiffness (core/model/joint.hpp) from the model's
+// elements and loads; reports a joint point far from both its bodies: beyond 3 radii of gyration
+// and beyond every element attachment point of each body (a fixed body reaches everywhere).
+void build_joints(const SceneSpecs& specs, const std::vector<ElementSpec>& elements, Model& model,
+                  Diagnostics& diag) {
+  std::vector<double> reach(model.bodies.size(), 0.0);
+  for (size_t i = 0; i < model.bodies.size(); ++i) {
+    const Body& b = model.bodies[i];
+    if (b.fixed) {
+      reach[i] = std::numeric_limits<double>::infinity();
+    } else {
+      const Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia);
+      reach[i] = 3.0 * std::sqrt(eig.eigenvalues().maxCoeff() / b.mass);
+    }
+  }
+  for (const ElementSpec& e : elements) {
+    reach[e.body1] = std::max(reach[e.body1], (e.p1 - model.bodies[e.body1].position).norm());
+    reach[e.body2] = std::max(reach[e.body2], (e.p2 - model.bodies[e.body2].position).norm());
+  }
+  for (const JointSpec& s : specs.joints) {
+    const Body& b1 = model.bodies[s.body1];
+    const Body& b2 = model.bodies[s.body2];
+    const double d1 = (s.point - b1.position).norm(), d2 = (s.point - b2.position).norm();
+    if (!(d1 <= reach[s.body1]) && !(d2 <= reach[s.body2])) {
+      char text[240];
+      std::snprintf(text, sizeof text,
+                    "joint \"%s\": the point is %.6g m from body \"%s\" and %.6g m from body "
+                    "\"%s\", beyond both bodies' extent (%.6g m, %.6g m: 3 radii of gyration "
+                    "or the farthest element end)",
+                    s.name.c_str(), d1, b1.name.c_str(), d2, b2.name.c_str(), reach[s.body1],
+                    reach[s.body2]);
+      diag.error(s.where.file, (s.where / "point").pointer, text);
+      continue;
+    }
+    Joint j;
+    j.name = s.name;
+    j.type = s.type;
+    j.body1 = s.body1, j.body2 = s.body2;
+    const Mat3 a1 = rotation_matrix<double>(b1.orientation);
+    const Mat3 a2 = rotation_matrix<double>(b2.orientation);
+    j.r1 = a1.transpose() * (s.point - b1.position);
+    j.r2 = a2.transpose() * (s.point - b2.position);
+    // The joint frame in global axes: the axis and two directions perpendicular to it.
+    Mat3 frame;
+    frame.col(0) = s.axis;
+    frame.col(1) = s.axis.unitOrthogonal();
+    frame.col(2) = s.axis.cross(frame.col(1));
+    j.frame1 = a1.transpose() * frame;
+    j.frame2 = a2.transpose() * frame;
+    j.centre_offset = b2.position - b1.position;
+    j.relative_compliance = s.relative_compliance;
+    model.joints.push_back(j);
+  }
+  const auto [kt, kr] = joint_stiffness_scale(model);
+  for (Joint& j : model.joints) {
+    j.k_force = kt / j.relative_compliance;
+    j.k_moment = kr / j.relative_compliance;
+  }
+}
+
 }  // namespace
 
 std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnostics& diag,
@@ -256,6 +318,7 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     read_elements(r, specs, false);
     read_elements(r, specs, true);
     read_loads(r, specs);
+    read_joints(r, specs);
   }
   if (diag.size() > errors_before) return std::nullopt;
   std::vector<SegmentChoice> choices;
@@ -387,6 +450,9 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     }
     model.loads.push_back(load);
   }
+  if (diag.size() > errors_before) return std::nullopt;
+
+  build_joints(specs, elements, model, diag);
   if (diag.size() > errors_before) return std::nullopt;
 
   model.load_cases = specs.load_cases;

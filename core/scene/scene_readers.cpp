@@ -1,4 +1,4 @@
-// Readers of the scene's materials, sections, bodies, beams, rails and loads.
+// Readers of the scene's materials, sections, bodies, beams, rails, joints and loads.
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -388,7 +388,8 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
         r.error("name", "must not be empty");
         ok = false;
       } else if (!specs.element_names.insert(*name).second) {
-        r.error("name", "duplicate element name \"" + *name + "\" (beams and rails share names)");
+        r.error("name",
+                "duplicate element name \"" + *name + "\" (beams, rails and joints share names)");
         ok = false;
       }
     }
@@ -471,6 +472,60 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     specs.loads.push_back(load);
     specs.load_points.push_back(point.value_or(specs.bodies[*body].position));
     specs.load_where.push_back(at);
+  });
+}
+
+void read_joints(ObjectReader& scene, SceneSpecs& specs) {
+  Diagnostics& diag = scene.diagnostics();
+  for_each_entry(scene, "joints", [&](const Json& v, const Where& at) {
+    ObjectReader r(v, at, diag);
+    if (!r.is_object()) return;
+    JointSpec j;
+    j.where = at;
+    const auto name = r.string("name", true);
+    const auto type = r.choice("type", true, {"spherical", "revolute", "fixed"});
+    const auto b1 = body_ref(r, "body1", specs), b2 = body_ref(r, "body2", specs);
+    const auto point = r.vec3("point", true);
+    std::optional<Vec3> axis;
+    if (type && *type == "revolute")
+      axis = r.vec3("axis", true);
+    else
+      r.allow({"axis"});
+    if (type && *type != "revolute" && v.contains("axis"))
+      r.error("axis", "only a revolute joint has an axis");
+    const auto compliance = r.positive("relative_compliance", false);
+    bool ok = name && type && b1 && b2 && point && (!type || *type != "revolute" || axis);
+    if (ok && *type == "revolute" && !(axis->norm() > 0.0 && std::isfinite(axis->norm()))) {
+      r.error("axis", "must be a non-zero direction");
+      ok = false;
+    }
+    if (compliance && !(*compliance < 1.0)) {
+      r.error("relative_compliance", "must be below 1 (the joint's compliance over the scene's)");
+      ok = false;
+    }
+    if (name) {
+      if (name->empty()) {
+        r.error("name", "must not be empty");
+        ok = false;
+      } else if (!specs.element_names.insert(*name).second) {
+        r.error("name",
+                "duplicate element name \"" + *name + "\" (beams, rails and joints share names)");
+        ok = false;
+      }
+    }
+    if (b1 && b2 && *b1 == *b2) {
+      r.error("body2", "a joint must join two different bodies");
+      ok = false;
+    }
+    if (!ok) return;
+    j.name = *name;
+    j.type = *type == "spherical"  ? JointType::kSpherical
+             : *type == "revolute" ? JointType::kRevolute
+                                   : JointType::kFixed;
+    j.body1 = *b1, j.body2 = *b2, j.point = *point;
+    if (axis) j.axis = axis->normalized();
+    if (compliance) j.relative_compliance = *compliance;
+    specs.joints.push_back(j);
   });
 }
 

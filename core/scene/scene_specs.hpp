@@ -56,6 +56,16 @@ struct ElementSpec {
   std::optional<std::vector<double>> travel;  // rails: [min, max] of the carriage's coordinate
 };
 
+struct JointSpec {
+  std::string name;
+  Where where;
+  JointType type = JointType::kSpherical;
+  int body1 = 0, body2 = 0;
+  Vec3 point = Vec3::Zero();
+  Vec3 axis = Vec3::UnitX();  // unit; revolute joints only
+  double relative_compliance = 1e-6;
+};
+
 struct SceneSpecs {
   Vec3 gravity = Vec3::Zero();
   std::map<std::string, MaterialSpec> materials;
@@ -65,11 +75,12 @@ struct SceneSpecs {
   // that is not found is not reported either: it may be the one that could not be read.
   std::set<std::string> invalid_materials, invalid_sections;
   bool materials_incomplete = false, sections_incomplete = false, bodies_incomplete = false;
-  std::set<std::string> element_names;  // beams and rails share one name space
+  std::set<std::string> element_names;  // beams, rails and joints share one name space
   std::vector<BodySpec> bodies;         // [0] is ground
   std::map<std::string, int> body_index;
   std::vector<ElementSpec> elements;
   long n_segments = 0;  // of the elements read so far (kMaxSegments + 1 once over the limit)
+  std::vector<JointSpec> joints;
   std::vector<Load> loads;
   std::vector<Vec3> load_points;        // global application point of each load
   std::vector<Where> load_where;        // where each load is given
@@ -86,6 +97,7 @@ void read_sections(ObjectReader& scene, SceneSpecs& specs);
 void read_bodies(ObjectReader& scene, SceneSpecs& specs);
 void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails);
 void read_loads(ObjectReader& scene, SceneSpecs& specs);
+void read_joints(ObjectReader& scene, SceneSpecs& specs);
 
 // Warnings (never errors) for what looks mistyped: members whose length, section area or mass is
 // two orders of magnitude or more from the median of the scene's members, and attachment or load

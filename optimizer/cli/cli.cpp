@@ -138,8 +138,9 @@ int check(const RunArguments& args) {
   for (const std::string& w : study->input_warnings) std::cerr << "warning: " << w << "\n";
   const Model& m = study->model;
   std::cout << args.study << ": ok (" << m.bodies.size() - 1 << " bodies, " << m.beams.size()
-            << " beams, " << m.rails.size() << " rails, " << m.n_states << " states, "
-            << study->analyses.size() << " analyses, " << study->responses.size()
+            << " beams, " << m.rails.size() << " rails, "
+            << (m.joints.empty() ? "" : std::to_string(m.joints.size()) + " joints, ") << m.n_states
+            << " states, " << study->analyses.size() << " analyses, " << study->responses.size()
             << " responses)\n";
   for (const SegmentChoice& c : m.segment_choices) {
     char line[200];

@@ -40,6 +40,7 @@ nlohmann::json model_summary(const Model& model) {
                      {"loads", model.loads.size()},
                      {"states", model.n_states},
                      {"degrees_of_freedom", model.n_dofs}};
+  if (!model.joints.empty()) out["joints"] = model.joints.size();
   if (!model.segment_choices.empty()) {
     nlohmann::json chosen = nlohmann::json::array();
     for (const SegmentChoice& c : model.segment_choices)

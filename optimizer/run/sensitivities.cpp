@@ -25,7 +25,8 @@ constexpr double kRelativeStep = 1e-4;
 bool same_topology(const Model& a, const Model& b) {
   return a.n_dofs == b.n_dofs && a.bodies.size() == b.bodies.size() &&
          a.beams.size() == b.beams.size() && a.rails.size() == b.rails.size() &&
-         a.loads.size() == b.loads.size() && a.free_bodies == b.free_bodies;
+         a.joints.size() == b.joints.size() && a.loads.size() == b.loads.size() &&
+         a.free_bodies == b.free_bodies;
 }
 
 class Sensitivities {

@@ -202,9 +202,9 @@ namespace {
 
 bool same_structure(const Model& a, const Model& b) {
   if (a.bodies.size() != b.bodies.size() || a.beams.size() != b.beams.size() ||
-      a.rails.size() != b.rails.size() || a.loads.size() != b.loads.size() ||
-      a.free_bodies != b.free_bodies || a.load_cases != b.load_cases ||
-      (a.gravity.norm() > 0.0) != (b.gravity.norm() > 0.0))
+      a.rails.size() != b.rails.size() || a.joints.size() != b.joints.size() ||
+      a.loads.size() != b.loads.size() || a.free_bodies != b.free_bodies ||
+      a.load_cases != b.load_cases || (a.gravity.norm() > 0.0) != (b.gravity.norm() > 0.0))
     return false;
   for (size_t i = 0; i < a.bodies.size(); ++i)
     if (a.bodies[i].name != b.bodies[i].name) return false;
@@ -212,6 +212,8 @@ bool same_structure(const Model& a, const Model& b) {
     if (a.beams[i].name != b.beams[i].name) return false;
   for (size_t i = 0; i < a.rails.size(); ++i)
     if (a.rails[i].name != b.rails[i].name) return false;
+  for (size_t i = 0; i < a.joints.size(); ++i)
+    if (a.joints[i].name != b.joints[i].name || a.joints[i].type != b.joints[i].type) return false;
   for (size_t i = 0; i < a.loads.size(); ++i)
     if (a.loads[i].body != b.loads[i].body || a.loads[i].kind != b.loads[i].kind ||
         a.loads[i].load_case != b.loads[i].load_case)

@@ -363,6 +363,37 @@ TEST_F(BadInput, FollowerLoadFlag) {
   EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
 }
 
+// Joints: an unknown body, a zero axis, a duplicate name, an axis on a joint without one and a
+// point far from both bodies are each one error at their pointer; a valid joint passes.
+TEST_F(BadInput, Joints) {
+  const Json hinge = {{"name", "hinge"},     {"type", "revolute"}, {"body1", "tip"},
+                      {"body2", "carriage"}, {"point", {1, 0, 0}}, {"axis", {0, 0, 1}}};
+  const Result ok = check(with("/scene/joints", Json::array({hinge})));
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
+  EXPECT_NE(ok.out.find("1 rails, 1 joints,"), std::string::npos) << ok.out;
+  const auto changed = [&](const std::string& key, const Json& value) {
+    Json j = hinge;
+    j[key] = value;
+    return with("/scene/joints", Json::array({j}));
+  };
+  EXPECT_TRUE(HasOnlyError(check(changed("body2", "nobody")),
+                           "bad.json:/scene/joints/0/body2:", "unknown body \"nobody\""));
+  EXPECT_TRUE(HasOnlyError(check(changed("axis", Json::array({0, 0, 0}))),
+                           "bad.json:/scene/joints/0/axis:", "must be a non-zero direction"));
+  EXPECT_TRUE(HasOnlyError(check(changed("name", "arm")),
+                           "bad.json:/scene/joints/0/name:", "duplicate element name \"arm\""));
+  Json twice = with("/scene/joints", Json::array({hinge, hinge}));
+  EXPECT_TRUE(HasOnlyError(check(twice),
+                           "bad.json:/scene/joints/1/name:", "duplicate element name \"hinge\""));
+  Json spherical = hinge;
+  spherical["type"] = "spherical";
+  EXPECT_TRUE(HasOnlyError(check(with("/scene/joints", Json::array({spherical}))),
+                           "bad.json:/scene/joints/0/axis:", "only a revolute joint has an axis"));
+  const Result far = check(changed("point", Json::array({50, 0, 0})));
+  EXPECT_TRUE(HasOnlyError(far, "bad.json:/scene/joints/0/point:", "beyond both bodies' extent"));
+  EXPECT_EQ(far.status, 2);
+}
+
 TEST_F(BadInput, TableTimesNotIncreasing) {
   EXPECT_TRUE(
       HasOnlyError(check(with("/scene/loads/1/time/t", {0, 0.2, 0.1})),

@@ -1,0 +1,70 @@
+// The joint kernel (docs/model.md "Joints"): a stiff penalty element between two bodies.
+//   gap g = p2 - p1 of the two bodies' joint points: U_t = 1/2 k_force |g|^2 (every type);
+//   revolute: the axes a1, a2 (column 0 of each joint frame, global): U_r = k_moment (1 - a1.a2);
+//   fixed: the three frame columns b1_i, b2_i: U_r = k_moment / 2 sum_i (1 - b1_i.b2_i).
+// For a small relative rotation theta (perpendicular to the axis for a revolute joint) both
+// rotational energies are k_moment theta^2 / 2: k_force and k_moment are the joint's stiffness.
+// A turn of any size about a revolute joint's axis costs nothing, and no angle limit applies.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/model/element_kinematics.hpp"
+#include "core/model/model.hpp"
+
+namespace beamrail {
+
+// Adds the joint's wrenches on bodies 1 and 2 to w1 and w2 and returns its energy [J].
+template <class T>
+T joint_wrenches(const Joint& j, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2) {
+  const Vec3T<T> lever1 = b1.A * j.r1.cast<T>(), lever2 = b2.A * j.r2.cast<T>();
+  const Vec3T<T> gap = j.centre_offset.cast<T>() + b2.u + lever2 - b1.u - lever1;
+  const Vec3T<T> f2 = -j.k_force * gap;  // the force on body 2 at its joint point
+  w2.template head<3>() += f2;
+  w2.template tail<3>() += lever2.cross(f2);
+  w1.template head<3>() -= f2;
+  w1.template tail<3>() -= lever1.cross(f2);
+  T energy = 0.5 * j.k_force * gap.squaredNorm();
+  if (j.type == JointType::kSpherical) return energy;
+  // U = c (1 - a1.a2): a turn dtheta2 of body 2 changes it by -c dtheta2.(a2 x a1), so the moment
+  // on body 2 is c a2 x a1, and on body 1 c a1 x a2.
+  const int columns = j.type == JointType::kRevolute ? 1 : 3;
+  const double c = j.type == JointType::kRevolute ? j.k_moment : 0.5 * j.k_moment;
+  for (int i = 0; i < columns; ++i) {
+    const Vec3T<T> a1 = b1.A * j.frame1.col(i).cast<T>(), a2 = b2.A * j.frame2.col(i).cast<T>();
+    const Vec3T<T> m2 = c * a2.cross(a1);
+    w2.template tail<3>() += m2;
+    w1.template tail<3>() -= m2;
+    energy += c * (1.0 - a1.dot(a2));
+  }
+  return energy;
+}
+
+// The scene's stiffness scale (translation [N/m], rotation [N m/rad]) that joints are made stiffer
+// than: the stiffest element's end stiffness (EA/L, 12 EI/L^3; GJ/L, 4 EI/L). Without elements,
+// the largest weight or force load over the joints' largest lever (the distance from a joint point
+// to its bodies' centres, 1 m when none): a joint then moves by relative_compliance times that
+// lever under that load.
+inline std::pair<double, double> joint_stiffness_scale(const Model& model) {
+  double kt = 0.0, kr = 0.0;
+  const auto element = [&](double ea, double gj, double eiy, double eiz, double l) {
+    const double ei = std::max(eiy, eiz);
+    kt = std::max({kt, ea / l, 12.0 * ei / (l * l * l)});
+    kr = std::max({kr, gj / l, 4.0 * ei / l});
+  };
+  for (const Beam& e : model.beams) element(e.ea, e.gj, e.eiy, e.eiz, e.ends.length);
+  for (const Rail& e : model.rails) element(0.0, e.gj, e.eiy, e.eiz, e.ends.length);
+  if (kt > 0.0 && kr > 0.0) return {kt, kr};
+  double load = 0.0, lever = 0.0;
+  for (const Body& b : model.bodies)
+    if (!b.fixed) load = std::max(load, b.mass * model.gravity.norm());
+  for (const Load& l : model.loads)
+    if (l.kind == LoadKind::kForce) load = std::max(load, l.value.norm());
+  for (const Joint& j : model.joints) lever = std::max({lever, j.r1.norm(), j.r2.norm()});
+  if (!(lever > 0.0)) lever = 1.0;
+  if (!(load > 0.0)) load = 1.0;
+  return {load / lever, load * lever};
+}
+
+}  // namespace beamrail

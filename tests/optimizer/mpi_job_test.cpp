@@ -256,6 +256,33 @@ TEST_F(MpiRun, AGridSweepOnTwoRanksWritesTheTablesOfOneProcess) {
   EXPECT_GE(not_ok, 1) << "the sweep was meant to hold a failing design";
 }
 
+// 12 designs on 3 ranks, 9 of them invalid (walls of 13, 15 and 20 mm on tubes of 10 to 12 mm
+// radius): whichever rank evaluates an invalid design, it is a row with its status, and the other
+// designs go on, as in one process. More designs on ranks 1 and 2 than there are valid ones: at
+// least one invalid design was evaluated on a rank other than 0.
+TEST_F(MpiRun, InvalidDesignsOnOtherRanksAreRowsAndTheSweepGoesOn) {
+  Json plan = grid_plan();
+  plan["variables"][0]["lower"] = 0.02;
+  plan["variables"][0]["upper"] = 0.024;
+  plan["variables"][0]["count"] = 3;
+  plan["variables"][1]["values"] = Json::array({0.003, 0.013, 0.015, 0.02});
+  ASSERT_NO_FATAL_FAILURE(expect_same_tables(tube_sweep(plan), 3, 1));
+  const auto rows = rows_without_wall(dir_ / "mpi" / "samples.csv");
+  size_t status = 0;
+  for (size_t i = 0; i < rows[0].size(); ++i)
+    if (rows[0][i] == "status") status = i;
+  std::map<std::string, long> count;
+  for (size_t i = 1; i < rows.size(); ++i) ++count[rows[i][status]];
+  EXPECT_EQ(count["ok"], 3);
+  EXPECT_EQ(count["invalid"], 9);
+  const Json many = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  ASSERT_EQ(many["designs_per_rank"].size(), 3u);
+  const long others =
+      many["designs_per_rank"][1].get<long>() + many["designs_per_rank"][2].get<long>();
+  EXPECT_GT(others, count["ok"]) << many["designs_per_rank"];
+  EXPECT_EQ(others + many["designs_per_rank"][0].get<long>(), 12);
+}
+
 // A Latin hypercube on 3 ranks of 2 threads each.
 TEST_F(MpiRun, AnLhsSweepOnThreeRanksOfTwoThreadsWritesTheTablesOfOneProcess) {
   ASSERT_NO_FATAL_FAILURE(expect_same_tables(tube_sweep(lhs_plan()), 3, 2));

@@ -266,12 +266,11 @@ int run(const RunArguments& args) {
 
   const StopOnSignals signals;
   // Under mpirun the other ranks evaluate a sweep's designs, run an optimization's starts and a
-  // work-precision study's runs; anything else runs here alone.
-  const bool spread = study->design && study->design->type != DesignStudy::Type::kSensitivity;
-  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !spread)
-    std::cerr << "beamrail: only sweeps, optimizations and work-precision studies spread over MPI "
-                 "ranks so far; this "
-                 "study runs on rank 0 alone (the other "
+  // work-precision study's runs, and evaluate a sensitivity check's designs; a single run runs
+  // here alone.
+  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !study->design)
+    std::cerr << "beamrail: only design studies spread over MPI ranks; this single run runs on "
+                 "rank 0 alone (the other "
               << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {

@@ -84,7 +84,7 @@ int report_sensitivity(const Study& study, const RunSettings& settings,
   summary["variables"] = variables;
   summary["responses"] = responses;
   summary["design_seconds"] = design_seconds;
-  summary["ranks"] = 1;
+  summary["ranks"] = result.ranks;
   summary["threads"] = result.threads;
   if (plan.sensitivity.check) {
     summary["check_seconds"] = check_seconds;

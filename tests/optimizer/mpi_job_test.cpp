@@ -440,6 +440,38 @@ Json without_times(Json summary) {
   return summary;
 }
 
+// A sensitivity study of the tube with its check on 3 ranks: the 4 designs of the central
+// differences go to the ranks, and sensitivities.csv (derivatives and differences) and summary.json
+// (times and ranks aside) are those of one process.
+TEST_F(MpiRun, ASensitivityCheckOnThreeRanksWritesTheTablesOfOneProcess) {
+  const Json study = tube_sweep(Json::parse(R"({"type": "sensitivity", "check": true,
+      "variables": [
+      {"name": "outer_diameter", "pointer": "/scene/sections/tube/outer_diameter"},
+      {"name": "wall", "pointer": "/scene/sections/tube/wall"}]})"));
+  const fs::path file = write_study("study.json", study);
+  const ProcessResult alone =
+      run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
+  ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
+  const ProcessResult mpi = run_mpi(3, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"});
+  ASSERT_TRUE(mpi.exited && mpi.status == 0) << mpi.how << "\n" << mpi.out << mpi.err;
+  EXPECT_EQ(mpi.err.find("rank 0 alone"), std::string::npos) << mpi.err;
+  const auto expected = rows_without_wall(dir_ / "alone" / "sensitivities.csv");
+  const auto got = rows_without_wall(dir_ / "mpi" / "sensitivities.csv");
+  ASSERT_EQ(expected.size(), 1u + 4u * 2u);  // 4 responses x 2 variables
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "row " << i;
+  // The check computed a difference for every row (no empty or nan field).
+  for (size_t i = 1; i < got.size(); ++i)
+    for (const std::string& field : got[i]) EXPECT_TRUE(!field.empty() && field != "nan") << i;
+  Json one = Json::parse(read_text(dir_ / "alone" / "summary.json"));
+  Json many = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  EXPECT_EQ(one["ranks"], 1);
+  EXPECT_EQ(many["ranks"], 3);
+  EXPECT_EQ(many["status"], "ok");
+  for (const char* key : {"design_seconds", "check_seconds"}) one.erase(key), many.erase(key);
+  EXPECT_EQ(without_times(many), without_times(one));
+}
+
 class MpiOptimization : public MpiRun {
  protected:
   // Runs the optimization in one process with -j 1 (into "alone") and under mpirun (into "mpi"),

@@ -25,11 +25,13 @@ struct SensitivityResult {
   std::vector<std::vector<double>> differences;
   std::string check_failure;
   int threads = 1;
+  int ranks = 1;  // that evaluated the check's designs (under mpirun, every rank)
   double design_seconds = 0.0, check_seconds = 0.0;
 };
 
 // Evaluates the study's own design with its derivatives (the variables in parallel on the threads
-// -j gives), and with "check" the designs of the central differences.
+// -j gives), and with "check" the designs of the central differences (through the batch
+// executor: under mpirun, spread over the ranks).
 SensitivityResult compute_sensitivities(const Study& study, const DesignEvaluator& evaluator,
                                         const RunSettings& settings);
 

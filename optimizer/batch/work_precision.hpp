@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "optimizer/batch/run_settings.hpp"
+#include "optimizer/run/status.hpp"
 #include "optimizer/run/trajectory.hpp"
 #include "optimizer/study/study.hpp"
 
@@ -29,7 +30,9 @@ struct PrecisionRun {
   std::string linear_solver;
   bool ok = false, timed_out = false;
   bool interrupted = false;  // cut short by a stop request: not a measurement
-  std::string status() const { return ok ? "ok" : timed_out ? "timeout" : "failed"; }
+  std::string status() const {
+    return status_name(ok ? Status::kOk : timed_out ? Status::kTimeout : Status::kFailed);
+  }
 };
 
 // The reference run: the plan's reference integrator on the study's transient analysis.

@@ -15,6 +15,7 @@
 #include "optimizer/batch/work_precision.hpp"
 #include "optimizer/cli/interruption.hpp"
 #include "optimizer/output/output_folder.hpp"
+#include "optimizer/output/result_tables.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
@@ -178,10 +179,23 @@ std::string resumable_table(const Study& study) {
 }
 
 int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
-  EvaluationOptions options{out};
+  EvaluationOptions options;
+  options.result_tables = true;
+  TimeseriesFiles timeseries(out);
+  options.timeseries = &timeseries;
   std::optional<VtkOutput> vtk_output;
   if (vtk) options.vtk = &vtk_output.emplace(out / "vtk");
   Evaluation ev = evaluate(study, study.model, options);
+  // The tables of the analyses that ran (those of a failed or interrupted run's earlier analyses
+  // too); a write error fails the analysis and, unless it failed already, the run.
+  for (AnalysisReport& report : ev.analyses) {
+    std::string table_error;
+    if (write_result_tables(out, report.result_tables, &table_error)) continue;
+    report.ok = false;
+    report.message = table_error;
+    if (ev.status == Status::kOk) ev.status = Status::kFailed, ev.message = table_error;
+    break;
+  }
   std::string vtk_error;
   if (vtk_output && !vtk_output->finish(nullptr, &vtk_error) && ev.status == Status::kOk)
     ev.status = Status::kFailed, ev.message = vtk_error;
@@ -253,12 +267,11 @@ int run(const RunArguments& args) {
 
   const StopOnSignals signals;
   // Under mpirun the other ranks evaluate a sweep's designs, run an optimization's starts and a
-  // work-precision study's runs; anything else runs here alone.
-  const bool spread = study->design && study->design->type != DesignStudy::Type::kSensitivity;
-  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !spread)
-    std::cerr << "beamrail: only sweeps, optimizations and work-precision studies spread over MPI "
-                 "ranks so far; this "
-                 "study runs on rank 0 alone (the other "
+  // work-precision study's runs, and evaluate a sensitivity check's designs; a single run runs
+  // here alone.
+  if (const MpiJob* job = mpi_job(); job && job->size() > 1 && !study->design)
+    std::cerr << "beamrail: only design studies spread over MPI ranks; this single run runs on "
+                 "rank 0 alone (the other "
               << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
   if (study->design) {

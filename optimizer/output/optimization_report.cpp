@@ -12,6 +12,7 @@
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/status.hpp"
 
 namespace beamrail {
 
@@ -247,16 +248,16 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
   const bool interrupted = signal != 0 && stopped;
   std::string status, message;
   if (!history_error.empty()) {
-    status = "failed", message = history_error;
+    status = status_name(Status::kFailed), message = history_error;
   } else if (!errors.empty()) {
-    status = "failed";
+    status = status_name(Status::kFailed);
     for (const std::string& e : errors) message += (message.empty() ? "" : "; ") + e;
   } else if (interrupted) {
-    status = "interrupted";
+    status = status_name(Status::kInterrupted);
     message = "interrupted by " + signal_name(signal) + " after " +
               std::to_string(records_.size()) + " designs";
   } else if (best) {
-    status = "ok";
+    status = status_name(Status::kOk);
   } else {
     status = "infeasible";
     message = "no evaluated design satisfies every constraint";
@@ -367,7 +368,7 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
     b["responses"] = resp;
     b["constraints"] = constraint_report(problem, best->outcome);
     b["active_tolerance"] = problem.active_tolerance();
-    if (status == "ok") {
+    if (status == status_name(Status::kOk)) {
       s["best"] = b;
       s["responses"] = resp;
       Json scene = evaluator.document(best->x);
@@ -392,12 +393,12 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
     return 1;
   }
   const std::string history = (settings_.output / "history.csv").string();
-  if (status == "failed") {
+  if (status == status_name(Status::kFailed)) {
     std::cerr << "beamrail: " << study_.name << " failed: " << message << "\n(" << records_.size()
               << " designs evaluated are in " << history << "; no best.json is written)\n";
     return 1;
   }
-  if (status == "interrupted") {
+  if (status == status_name(Status::kInterrupted)) {
     std::cerr << "beamrail: " << study_.name << " interrupted by " << signal_name(signal) << ": "
               << records_.size() << " designs are in " << history
               << "; continue with: " << settings_.command << " --resume\n";

@@ -6,6 +6,7 @@
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/status.hpp"
 
 namespace beamrail {
 namespace {
@@ -52,18 +53,19 @@ int report_sensitivity(const Study& study, const RunSettings& settings,
     written = table.commit(&error);
   }
 
-  std::string status = "ok", message;
+  std::string status = status_name(Status::kOk), message;
   if (design.status != Status::kOk) {
-    status = design.status == Status::kInterrupted ? "interrupted" : "failed";
+    status = design.status == Status::kInterrupted ? status_name(Status::kInterrupted)
+                                                   : status_name(Status::kFailed);
     message = "the study's design did not evaluate: " + design.message;
   } else if (!s.ok) {
-    status = "failed";
+    status = status_name(Status::kFailed);
     message = s.message;
   } else if (!check_failure.empty()) {
-    status = "failed";
+    status = status_name(Status::kFailed);
     message = check_failure;
   } else if (!written) {
-    status = "failed";
+    status = status_name(Status::kFailed);
     message = error;
   }
   nlohmann::json summary;
@@ -84,7 +86,7 @@ int report_sensitivity(const Study& study, const RunSettings& settings,
   summary["variables"] = variables;
   summary["responses"] = responses;
   summary["design_seconds"] = design_seconds;
-  summary["ranks"] = 1;
+  summary["ranks"] = result.ranks;
   summary["threads"] = result.threads;
   if (plan.sensitivity.check) {
     summary["check_seconds"] = check_seconds;
@@ -100,7 +102,7 @@ int report_sensitivity(const Study& study, const RunSettings& settings,
     return 1;
   }
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
-  if (status != "ok") {
+  if (status != status_name(Status::kOk)) {
     std::cerr << "beamrail: " << study.name << " " << status << ": " << message << "\n";
     return 1;
   }

@@ -5,6 +5,7 @@
 
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/status.hpp"
 
 namespace beamrail {
 
@@ -19,7 +20,7 @@ int fail_before_designs(const Study& study, const std::filesystem::path& output,
                          {"file", study.file},
                          {"beamrail_version", kVersion},
                          {"type", type},
-                         {"status", "failed"},
+                         {"status", status_name(Status::kFailed)},
                          {"message", message},
                          {"warnings", study.input_warnings}};
   std::string error;
@@ -72,10 +73,10 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
   for (const AnalysisReport& a : ev.analyses) {
     nlohmann::json j{{"name", a.name},
                      {"type", a.type},
-                     {"status", a.ok            ? "ok"
-                                : a.interrupted ? "interrupted"
-                                : a.timed_out   ? "timeout"
-                                                : "failed"},
+                     {"status", a.ok            ? status_name(Status::kOk)
+                                : a.interrupted ? status_name(Status::kInterrupted)
+                                : a.timed_out   ? status_name(Status::kTimeout)
+                                                : status_name(Status::kFailed)},
                      {"message", a.message},
                      {"wall_seconds", a.wall_seconds},
                      {"tables", a.tables}};
@@ -107,7 +108,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["energy_max_relative_change"] = json_number(a.energy_max_relative_change);
       if (const auto& v = a.verification)
         j["verification"] = {
-            {"status", v->ok ? "ok" : "failed"},
+            {"status", v->ok ? status_name(Status::kOk) : status_name(Status::kFailed)},
             {"message", v->message},
             {"rtol", v->rtol},
             {"atol", v->atol},

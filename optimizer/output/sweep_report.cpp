@@ -8,6 +8,7 @@
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/status.hpp"
 
 namespace beamrail {
 
@@ -29,7 +30,7 @@ int SweepTable::open() {
     return status;
   for (const CsvRow& row : existing) {
     resumed_.insert(std::strtol(row[0].c_str(), nullptr, 10));
-    resumed_failed_ += row[status_column] != "ok";
+    resumed_failed_ += row[status_column] != status_name(Status::kOk);
     resumed_warned_ += std::strtol(row[status_column + 1].c_str(), nullptr, 10) > 0;
   }
   return 0;
@@ -61,7 +62,9 @@ int report_sweep(const Study& study, const RunSettings& settings, const SweepTab
   s["file"] = study.file;
   s["beamrail_version"] = kVersion;
   s["type"] = "sweep";
-  s["status"] = !written ? "failed" : interrupted ? "interrupted" : "ok";
+  s["status"] = !written      ? status_name(Status::kFailed)
+                : interrupted ? status_name(Status::kInterrupted)
+                              : status_name(Status::kOk);
   s["message"] = !written      ? table.error()
                  : interrupted ? "interrupted by " + signal_name(signal) + " after " +
                                      std::to_string(finished) + " of " +

@@ -7,6 +7,7 @@
 #include "optimizer/cli/interruption.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/status.hpp"
 
 namespace beamrail {
 
@@ -71,7 +72,7 @@ int report_no_runs(const Study& study, const RunSettings& settings,
   nlohmann::json s = base_summary(study);
   if (reference.result.interrupted) {
     const int signal = stop_requested();
-    write_summary(s, study, settings, "interrupted",
+    write_summary(s, study, settings, status_name(Status::kInterrupted),
                   "interrupted by " + signal_name(signal) + " in the reference run");
     std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal)
               << " in the reference run; nothing to keep\n";
@@ -79,7 +80,7 @@ int report_no_runs(const Study& study, const RunSettings& settings,
   }
   const std::string message =
       !reference.result.ok ? "the reference run failed: " + reference.result.message : table_error;
-  write_summary(s, study, settings, "failed", message);
+  write_summary(s, study, settings, status_name(Status::kFailed), message);
   std::cerr << "beamrail: " << message << "\n";
   return 1;
 }
@@ -123,12 +124,12 @@ int report_work_precision(const Study& study, const RunSettings& settings,
   summary["ranks"] = result.ranks;
   if (result.ranks > 1) summary["runs_per_rank"] = result.runs_per_rank;
   if (!table_error.empty()) {
-    write_summary(summary, study, settings, "failed", table_error);
+    write_summary(summary, study, settings, status_name(Status::kFailed), table_error);
     std::cerr << "beamrail: " << table_error << "\n";
     return 1;
   }
   if (interrupted) {
-    if (!write_summary(summary, study, settings, "interrupted",
+    if (!write_summary(summary, study, settings, status_name(Status::kInterrupted),
                        "interrupted by " + signal_name(signal) + " after " + std::to_string(runs) +
                            " of " + std::to_string(result.planned) + " runs"))
       return 1;
@@ -138,7 +139,7 @@ int report_work_precision(const Study& study, const RunSettings& settings,
               << "; a work-precision study does not resume: run it again to measure them all\n";
     return interrupted_exit_status(signal);
   }
-  if (!write_summary(summary, study, settings, "ok", "")) return 1;
+  if (!write_summary(summary, study, settings, status_name(Status::kOk), "")) return 1;
   std::cout << study.name << ": " << runs << " runs (" << failed << " failed or timed out)";
   if (!best.is_null())
     std::cout << "; fastest within " << format_number(plan.target_error) << ": "

@@ -8,7 +8,6 @@
 #include <memory>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/output/result_tables.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/vtk_output.hpp"
 #include "optimizer/run/expressions.hpp"
@@ -137,14 +136,8 @@ class Runner {
           return options_.vtk->write_static(spec.name, model, *e.data, error);
         }))
       return;
-    if (!writes_tables()) return;
-    const std::string prefix = table_prefix(spec);
-    std::string error;
-    if (!write_static_tables(options_.output_directory, prefix, model, *e.data, &error)) {
-      report.ok = false;
-      report.message = error;
-    }
-    report.tables = {prefix + "static_displacements.csv", prefix + "element_forces.csv"};
+    if (options_.result_tables)
+      keep_tables(report, static_tables(table_prefix(spec), model, *e.data));
   }
 
   void run_modal(int index, AnalysisReport& report) {
@@ -200,14 +193,7 @@ class Runner {
           return options_.vtk->write_modes(spec.name, model, data, r, error);
         }))
       return;
-    if (!writes_tables()) return;
-    const std::string prefix = table_prefix(spec);
-    std::string error;
-    if (!write_modal_tables(options_.output_directory, prefix, model, r, &error)) {
-      report.ok = false;
-      report.message = error;
-    }
-    report.tables = {prefix + "modes.csv", prefix + "mode_shapes.csv"};
+    if (options_.result_tables) keep_tables(report, modal_tables(table_prefix(spec), model, r));
   }
 
   // Buckling of a load case: its loads scaled, the loads without a case and gravity held (the
@@ -271,14 +257,7 @@ class Runner {
           return options_.vtk->write_buckling(spec.name, model_, data, r, error);
         }))
       return;
-    if (!writes_tables()) return;
-    const std::string prefix = table_prefix(spec);
-    std::string error;
-    if (!write_buckling_tables(options_.output_directory, prefix, model_, r, &error)) {
-      report.ok = false;
-      report.message = error;
-    }
-    report.tables = {prefix + "buckling.csv", prefix + "buckling_shapes.csv"};
+    if (options_.result_tables) keep_tables(report, buckling_tables(table_prefix(spec), model_, r));
   }
 
   void run_transient_analysis(int index, AnalysisReport& report) {
@@ -308,15 +287,14 @@ class Runner {
         ev_.responses[k] = 0.0;
       }
     if (options_.vtk && !options_.vtk->begin_series(spec.name, model, &report.message)) return;
-    TimeseriesWriter table;
+    TransientSink* const table = options_.timeseries;
     std::string table_error;
-    const bool tables = writes_tables();
     const std::string file = table_file(spec, "timeseries.csv");
-    if (tables && !table.open(options_.output_directory / file, model, &table_error)) {
+    if (table && !table->begin(file, model, &table_error)) {
       report.message = table_error;
       return;
     }
-    if (tables) report.tables = {file};
+    if (table) report.tables = {file};
 
     Trajectory trajectory = trajectory_of(model);
     bool first = true;
@@ -327,7 +305,7 @@ class Runner {
           std::max(report.energy_max_change, std::abs(s.energy() - report.energy_initial));
       for (auto& [k, t] : peaks)
         ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
-      if (tables) table.write(s, d);  // throws when the table cannot be written: the run fails
+      if (table) table->sample(s, d);  // throws when it cannot be kept: the run fails
       if (options_.vtk) options_.vtk->frame(s.t, d);  // throws likewise
       if (spec.verify) trajectory.record(s, d);
     };
@@ -335,7 +313,7 @@ class Runner {
     report.energy_max_relative_change =
         report.energy_initial != 0.0 ? report.energy_max_change / std::abs(report.energy_initial)
                                      : kNaN;
-    if (tables) table.commit(&table_error);
+    if (table) table->end(&table_error);
     if (options_.vtk && table_error.empty()) options_.vtk->end_series(&table_error);
     report.ok = result.ok;
     report.timed_out = result.timed_out;
@@ -394,7 +372,10 @@ class Runner {
       if (chosen[k] >= 0) state.response_mode[k] = column[chosen[k]];
   }
 
-  bool writes_tables() const { return !options_.output_directory.empty(); }
+  static void keep_tables(AnalysisReport& report, std::vector<ResultTable> tables) {
+    for (const ResultTable& t : tables) report.tables.push_back(t.file);
+    report.result_tables = std::move(tables);
+  }
 
   // Writes the analysis's VTK files when asked for (write(&error)); false, with the analysis
   // failed, when they cannot be written.

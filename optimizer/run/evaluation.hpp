@@ -1,5 +1,6 @@
 // One evaluation of a design: run the study's analyses on a Model, compute its responses, and
-// (for single runs) write the full result tables. Failures become a status, never an exception.
+// (for single runs) keep the full result tables as data; it writes no files (output/ does).
+// Failures become a status, never an exception.
 #pragma once
 
 #include <filesystem>
@@ -12,8 +13,10 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
+#include "optimizer/output/result_tables.hpp"
 #include "optimizer/run/responses.hpp"
 #include "optimizer/run/status.hpp"
+#include "optimizer/run/transient_sink.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
@@ -33,7 +36,9 @@ struct AnalysisReport {
   std::string type;                 // "transient", "static", "modal", "buckling"
   std::string name;                 // the analysis's name in the study
   std::string load_case;            // "" when it applies the loads without a case only
-  std::vector<std::string> tables;  // the files it wrote
+  std::vector<std::string> tables;  // its result tables' files (result_tables and time series)
+  // static, modal, buckling: its tables (EvaluationOptions::result_tables)
+  std::vector<ResultTable> result_tables;
   bool ok = false;
   bool timed_out = false;    // stopped by a max_seconds budget
   bool interrupted = false;  // stopped by a stop request (SIGINT, SIGTERM)
@@ -122,7 +127,11 @@ struct Evaluation {
 };
 
 struct EvaluationOptions {
-  std::filesystem::path output_directory;  // empty: write no tables (batch evaluations)
+  // Keep the tables of static, modal and buckling analyses (AnalysisReport::result_tables);
+  // false for batch evaluations.
+  bool result_tables = false;
+  // Where the samples of transient analyses go as they are computed; nullptr: nowhere.
+  TransientSink* timeseries = nullptr;
   // Wall-clock budget of the whole evaluation [s]; 0: none. A transient still running when it is
   // spent stops, and the evaluation's status is "timeout".
   double max_seconds = 0.0;

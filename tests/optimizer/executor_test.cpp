@@ -1,5 +1,5 @@
 // Evaluating designs at the library level: evaluate() (optimizer/run/evaluation.hpp) returns its
-// results and writes no file without an output directory; the thread executor
+// results, its result tables as data when asked for, and writes no file; the thread executor
 // (optimizer/batch/executor.hpp) hands every design back once, one call at a time, with the
 // outcome that evaluating it alone gives, and starts none after its callback says stop or after a
 // stop request.
@@ -50,7 +50,7 @@ Study load(const Json& doc) {
   return study ? std::move(*study) : Study{};
 }
 
-TEST(Evaluation, ReturnsTheResponsesAndWritesNothingWithoutAnOutputDirectory) {
+TEST(Evaluation, ReturnsTheResponsesAndWritesNothing) {
   const Study study = load(sweep_study());
   std::string pattern = (fs::temp_directory_path() / "beamrail_eval_XXXXXX").string();
   ASSERT_NE(mkdtemp(pattern.data()), nullptr);
@@ -67,6 +67,43 @@ TEST(Evaluation, ReturnsTheResponsesAndWritesNothingWithoutAnOutputDirectory) {
   EXPECT_NEAR(ev.responses[0] / exact, 1.0, 1e-9);
   ASSERT_EQ(ev.analyses.size(), 1u);
   EXPECT_TRUE(ev.analyses[0].tables.empty());
+}
+
+// With result_tables, the static analysis's tables come back as data (the tip's row holds the
+// deflection, the beam's two ends the 1 mN load) and still no file is written.
+TEST(Evaluation, ReturnsTheResultTablesAsDataAndWritesNothing) {
+  const Study study = load(sweep_study());
+  std::string pattern = (fs::temp_directory_path() / "beamrail_eval_XXXXXX").string();
+  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+  const fs::path before = fs::current_path();
+  fs::current_path(pattern);
+  EvaluationOptions options;
+  options.result_tables = true;
+  const Evaluation ev = evaluate(study, study.model, options);
+  fs::current_path(before);
+  EXPECT_TRUE(fs::is_empty(pattern));
+  fs::remove_all(pattern);
+  ASSERT_EQ(ev.status, Status::kOk) << ev.message;
+  ASSERT_EQ(ev.analyses.size(), 1u);
+  const AnalysisReport& a = ev.analyses[0];
+  EXPECT_EQ(a.tables, (std::vector<std::string>{"static_displacements.csv", "element_forces.csv"}));
+  ASSERT_EQ(a.result_tables.size(), 2u);
+  const ResultTable& displacements = a.result_tables[0];
+  EXPECT_EQ(displacements.header,
+            (std::vector<std::string>{"body", "dx", "dy", "dz", "rx", "ry", "rz"}));
+  ASSERT_EQ(displacements.rows.size(), 1u);
+  EXPECT_EQ(displacements.rows[0][0], "tip");
+  EXPECT_EQ(std::stod(displacements.rows[0][3]), -ev.responses[0]);
+  const ResultTable& forces = a.result_tables[1];
+  ASSERT_EQ(forces.rows.size(), 2u);  // the beam's two ends
+  EXPECT_EQ(forces.rows[0][0], "arm");
+  EXPECT_EQ(forces.rows[1][1], "2");
+  // The shear at each end: the 1 mN load, to the static tolerance.
+  for (const auto& row : forces.rows) {
+    double shear = 0.0;
+    for (int c = 2; c < 5; ++c) shear = std::max(shear, std::abs(std::stod(row[c])));
+    EXPECT_NEAR(shear, 1e-3, 1e-9) << row[1];
+  }
 }
 
 std::vector<Design> widths() {

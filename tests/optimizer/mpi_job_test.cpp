@@ -256,6 +256,33 @@ TEST_F(MpiRun, AGridSweepOnTwoRanksWritesTheTablesOfOneProcess) {
   EXPECT_GE(not_ok, 1) << "the sweep was meant to hold a failing design";
 }
 
+// 12 designs on 3 ranks, 9 of them invalid (walls of 13, 15 and 20 mm on tubes of 10 to 12 mm
+// radius): whichever rank evaluates an invalid design, it is a row with its status, and the other
+// designs go on, as in one process. More designs on ranks 1 and 2 than there are valid ones: at
+// least one invalid design was evaluated on a rank other than 0.
+TEST_F(MpiRun, InvalidDesignsOnOtherRanksAreRowsAndTheSweepGoesOn) {
+  Json plan = grid_plan();
+  plan["variables"][0]["lower"] = 0.02;
+  plan["variables"][0]["upper"] = 0.024;
+  plan["variables"][0]["count"] = 3;
+  plan["variables"][1]["values"] = Json::array({0.003, 0.013, 0.015, 0.02});
+  ASSERT_NO_FATAL_FAILURE(expect_same_tables(tube_sweep(plan), 3, 1));
+  const auto rows = rows_without_wall(dir_ / "mpi" / "samples.csv");
+  size_t status = 0;
+  for (size_t i = 0; i < rows[0].size(); ++i)
+    if (rows[0][i] == "status") status = i;
+  std::map<std::string, long> count;
+  for (size_t i = 1; i < rows.size(); ++i) ++count[rows[i][status]];
+  EXPECT_EQ(count["ok"], 3);
+  EXPECT_EQ(count["invalid"], 9);
+  const Json many = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  ASSERT_EQ(many["designs_per_rank"].size(), 3u);
+  const long others =
+      many["designs_per_rank"][1].get<long>() + many["designs_per_rank"][2].get<long>();
+  EXPECT_GT(others, count["ok"]) << many["designs_per_rank"];
+  EXPECT_EQ(others + many["designs_per_rank"][0].get<long>(), 12);
+}
+
 // A Latin hypercube on 3 ranks of 2 threads each.
 TEST_F(MpiRun, AnLhsSweepOnThreeRanksOfTwoThreadsWritesTheTablesOfOneProcess) {
   ASSERT_NO_FATAL_FAILURE(expect_same_tables(tube_sweep(lhs_plan()), 3, 2));
@@ -411,6 +438,38 @@ Json without_times(Json summary) {
                           "starts_per_rank", "designs_per_rank", "scheduler_seconds"})
     summary.erase(key);
   return summary;
+}
+
+// A sensitivity study of the tube with its check on 3 ranks: the 4 designs of the central
+// differences go to the ranks, and sensitivities.csv (derivatives and differences) and summary.json
+// (times and ranks aside) are those of one process.
+TEST_F(MpiRun, ASensitivityCheckOnThreeRanksWritesTheTablesOfOneProcess) {
+  const Json study = tube_sweep(Json::parse(R"({"type": "sensitivity", "check": true,
+      "variables": [
+      {"name": "outer_diameter", "pointer": "/scene/sections/tube/outer_diameter"},
+      {"name": "wall", "pointer": "/scene/sections/tube/wall"}]})"));
+  const fs::path file = write_study("study.json", study);
+  const ProcessResult alone =
+      run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
+  ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
+  const ProcessResult mpi = run_mpi(3, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"});
+  ASSERT_TRUE(mpi.exited && mpi.status == 0) << mpi.how << "\n" << mpi.out << mpi.err;
+  EXPECT_EQ(mpi.err.find("rank 0 alone"), std::string::npos) << mpi.err;
+  const auto expected = rows_without_wall(dir_ / "alone" / "sensitivities.csv");
+  const auto got = rows_without_wall(dir_ / "mpi" / "sensitivities.csv");
+  ASSERT_EQ(expected.size(), 1u + 4u * 2u);  // 4 responses x 2 variables
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "row " << i;
+  // The check computed a difference for every row (no empty or nan field).
+  for (size_t i = 1; i < got.size(); ++i)
+    for (const std::string& field : got[i]) EXPECT_TRUE(!field.empty() && field != "nan") << i;
+  Json one = Json::parse(read_text(dir_ / "alone" / "summary.json"));
+  Json many = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  EXPECT_EQ(one["ranks"], 1);
+  EXPECT_EQ(many["ranks"], 3);
+  EXPECT_EQ(many["status"], "ok");
+  for (const char* key : {"design_seconds", "check_seconds"}) one.erase(key), many.erase(key);
+  EXPECT_EQ(without_times(many), without_times(one));
 }
 
 class MpiOptimization : public MpiRun {

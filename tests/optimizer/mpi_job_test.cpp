@@ -235,6 +235,25 @@ class MpiRun : public ::testing::Test {
     EXPECT_EQ(many["evaluated_now"], expected.size() - 1);
   }
 
+  // Resumes the stopped job of `file` in "mpi" on 2 ranks and checks that its samples.csv (a
+  // header and `designs` rows) equals the table one process writes into "alone"; returns the
+  // resumed job's summary.
+  Json resume_and_compare(const fs::path& file, size_t designs) {
+    const ProcessResult resumed =
+        run_mpi(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet", "--resume"});
+    EXPECT_TRUE(resumed.exited && resumed.status == 0) << resumed.how << "\n" << resumed.err;
+    const ProcessResult alone =
+        run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
+    EXPECT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
+    const auto expected = rows_without_wall(dir_ / "alone" / "samples.csv");
+    const auto got = rows_without_wall(dir_ / "mpi" / "samples.csv");
+    EXPECT_EQ(got.size(), designs + 1);
+    EXPECT_EQ(got, expected);
+    const Json summary = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+    EXPECT_EQ(summary["ranks"], 2);
+    return summary;
+  }
+
   fs::path dir_;
 };
 
@@ -288,24 +307,28 @@ TEST_F(MpiRun, AnLhsSweepOnThreeRanksOfTwoThreadsWritesTheTablesOfOneProcess) {
   ASSERT_NO_FATAL_FAILURE(expect_same_tables(tube_sweep(lhs_plan()), 3, 2));
 }
 
-// A 40-design sweep of short transients under mpirun, stopped part-way by SIGTERM to mpirun (as
-// a cluster's scheduler ends a job), then resumed under mpirun: the table holds each design
-// once, equal to one process's.
-TEST_F(MpiRun, AJobStoppedPartWayResumesUnderMpirunWithEachDesignOnce) {
-  Json study = tube_sweep(Json::parse(R"({"type": "sweep", "variables": [{"name": "load",
-      "pointer": "/scene/loads/0/value/1", "lower": -300, "upper": -100, "count": 40}]})"));
+// A sweep of `count` short transients of the tube over its side load.
+Json transient_load_sweep(int count) {
+  Json study = tube_sweep({{"type", "sweep"},
+                           {"variables", Json::array({{{"name", "load"},
+                                                       {"pointer", "/scene/loads/0/value/1"},
+                                                       {"lower", -300},
+                                                       {"upper", -100},
+                                                       {"count", count}}})}});
   study["analyses"] = Json::parse(R"([{"type": "transient", "t_end": 0.05, "output_step": 0.001,
       "integrator": {"rtol": 1e-9, "atol": 1e-12}}])");
   study["responses"] = Json::parse(R"({"peak": {"quantity": "peak_displacement",
       "body": "tip", "direction": [0, 1, 0]}})");
-  const fs::path file = write_study("study.json", study);
+  return study;
+}
+
+// A 40-design sweep of short transients under mpirun, stopped part-way by SIGTERM to mpirun (as
+// a cluster's scheduler ends a job), then resumed under mpirun: the table holds each design
+// once, equal to one process's.
+TEST_F(MpiRun, AJobStoppedPartWayResumesUnderMpirunWithEachDesignOnce) {
+  const fs::path file = write_study("study.json", transient_load_sweep(40));
   const fs::path samples = dir_ / "mpi" / "samples.csv";
-  auto rows_now = [&] {
-    std::error_code ec;
-    if (!fs::exists(samples, ec)) return size_t{0};
-    const std::string text = read_text(samples);
-    return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
-  };
+  auto rows_now = [&] { return lines_of(samples); };
   {
     Process p(BEAMRAIL_MPIEXEC,
               mpirun_args(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"}), dir_);
@@ -318,21 +341,9 @@ TEST_F(MpiRun, AJobStoppedPartWayResumesUnderMpirunWithEachDesignOnce) {
   }
   const size_t kept = rows_now();
   EXPECT_GE(kept, 4u);
-  const ProcessResult resumed =
-      run_mpi(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet", "--resume"});
-  ASSERT_TRUE(resumed.exited && resumed.status == 0) << resumed.how << "\n" << resumed.err;
-  const ProcessResult alone =
-      run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
-  ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
-  const auto expected = rows_without_wall(dir_ / "alone" / "samples.csv");
-  const auto got = rows_without_wall(samples);
-  ASSERT_EQ(got.size(), 41u);
-  ASSERT_EQ(got.size(), expected.size());
-  for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "row " << i;
-  const Json summary = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  const Json summary = resume_and_compare(file, 40);
   EXPECT_EQ(summary["resumed_from_table"].get<size_t>() + summary["evaluated_now"].get<size_t>(),
             40u);
-  EXPECT_EQ(summary["ranks"], 2);
 }
 
 // A 120-design sweep of short transients under mpirun, ended part-way as a failing node or a
@@ -340,13 +351,7 @@ TEST_F(MpiRun, AJobStoppedPartWayResumesUnderMpirunWithEachDesignOnce) {
 // run on and finish the sweep). Resumed under mpirun, the job evaluates exactly the designs whose
 // rows were not in samples.csv, and the table equals one process's: nothing lost, nothing twice.
 TEST_F(MpiRun, AJobKilledWholeResumesUnderMpirunWithNothingLostOrDuplicated) {
-  Json study = tube_sweep(Json::parse(R"({"type": "sweep", "variables": [{"name": "load",
-      "pointer": "/scene/loads/0/value/1", "lower": -300, "upper": -100, "count": 120}]})"));
-  study["analyses"] = Json::parse(R"([{"type": "transient", "t_end": 0.05, "output_step": 0.001,
-      "integrator": {"rtol": 1e-9, "atol": 1e-12}}])");
-  study["responses"] = Json::parse(R"({"peak": {"quantity": "peak_displacement",
-      "body": "tip", "direction": [0, 1, 0]}})");
-  const fs::path file = write_study("study.json", study);
+  const fs::path file = write_study("study.json", transient_load_sweep(120));
   const fs::path samples = dir_ / "mpi" / "samples.csv";
   auto lines_now = [&] { return lines_of(samples); };
   {
@@ -360,21 +365,9 @@ TEST_F(MpiRun, AJobKilledWholeResumesUnderMpirunWithNothingLostOrDuplicated) {
   const size_t kept = lines_now();  // the header and the whole rows
   EXPECT_GE(kept, 11u);
   ASSERT_LT(kept, 121u) << "the job was meant to be killed part-way";
-  const ProcessResult resumed =
-      run_mpi(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet", "--resume"});
-  ASSERT_TRUE(resumed.exited && resumed.status == 0) << resumed.how << "\n" << resumed.err;
-  const ProcessResult alone =
-      run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
-  ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
-  const auto expected = rows_without_wall(dir_ / "alone" / "samples.csv");
-  const auto got = rows_without_wall(samples);
-  ASSERT_EQ(got.size(), 121u);
-  ASSERT_EQ(got.size(), expected.size());
-  for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "row " << i;
-  const Json summary = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
+  const Json summary = resume_and_compare(file, 120);
   EXPECT_EQ(summary["resumed_from_table"].get<size_t>(), kept - 1);
   EXPECT_EQ(summary["evaluated_now"].get<size_t>(), 121 - kept);
-  EXPECT_EQ(summary["ranks"], 2);
 }
 
 // A work-precision study (3 methods at 2 tolerances on a short transient of the tube) on 3 ranks:

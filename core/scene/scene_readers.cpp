@@ -183,6 +183,21 @@ std::optional<int> body_ref(ObjectReader& r, const std::string& key, const Scene
   return it->second;
 }
 
+// Takes `name` for an element (beams, rails and joints share one name space); false, reported
+// at "name", when it is empty or taken.
+bool claim_element_name(ObjectReader& r, const std::string& name, SceneSpecs& specs) {
+  if (name.empty()) {
+    r.error("name", "must not be empty");
+    return false;
+  }
+  if (!specs.element_names.insert(name).second) {
+    r.error("name",
+            "duplicate element name \"" + name + "\" (beams, rails and joints share names)");
+    return false;
+  }
+  return true;
+}
+
 // Whether an optional member is present but not of the expected kind (reported by the caller).
 bool unusable(ObjectReader& scene, const std::string& key, bool array) {
   const Json* v = scene.member(key, false);
@@ -383,16 +398,7 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
       }
     }
     bool ok = name && b1 && b2 && p1 && p2 && p3 && material && section;
-    if (name) {
-      if (name->empty()) {
-        r.error("name", "must not be empty");
-        ok = false;
-      } else if (!specs.element_names.insert(*name).second) {
-        r.error("name",
-                "duplicate element name \"" + *name + "\" (beams, rails and joints share names)");
-        ok = false;
-      }
-    }
+    if (name && !claim_element_name(r, *name, specs)) ok = false;
     // A material or section declared but invalid was reported where it is declared.
     if (material && !specs.materials.count(*material)) {
       if (!specs.invalid_materials.count(*material) && !specs.materials_incomplete)
@@ -503,16 +509,7 @@ void read_joints(ObjectReader& scene, SceneSpecs& specs) {
       r.error("relative_compliance", "must be below 1 (the joint's compliance over the scene's)");
       ok = false;
     }
-    if (name) {
-      if (name->empty()) {
-        r.error("name", "must not be empty");
-        ok = false;
-      } else if (!specs.element_names.insert(*name).second) {
-        r.error("name",
-                "duplicate element name \"" + *name + "\" (beams, rails and joints share names)");
-        ok = false;
-      }
-    }
+    if (name && !claim_element_name(r, *name, specs)) ok = false;
     if (b1 && b2 && *b1 == *b2) {
       r.error("body2", "a joint must join two different bodies");
       ok = false;

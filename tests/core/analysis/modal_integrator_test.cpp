@@ -1,7 +1,6 @@
 // The modal (exponential) integrator: its phi functions against closed forms, exactness on a
 // linear motion, agreement with a tight reference on planar and 3-D motions and across load
 // breakpoints, its observed order of convergence, and its limits (scene size, large rotations).
-#include "core/analysis/exponential_step.hpp"
 #include "core/analysis/modal_integrator.hpp"
 
 #include <gtest/gtest.h>
@@ -10,6 +9,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/analysis/exponential_step.hpp"
 #include "tests/support/reference_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 

@@ -235,6 +235,14 @@ class MpiRun : public ::testing::Test {
     EXPECT_EQ(many["evaluated_now"], expected.size() - 1);
   }
 
+  // Waits until `table` has `lines` lines (the header and whole rows), `p` has ended, or 60 s
+  // have passed.
+  static void wait_for_lines(Process& p, const fs::path& table, size_t lines) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (lines_of(table) < lines && p.alive() && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+
   // Resumes the stopped job of `file` in "mpi" on 2 ranks and checks that its samples.csv (a
   // header and `designs` rows) equals the table one process writes into "alone"; returns the
   // resumed job's summary.
@@ -328,18 +336,15 @@ Json transient_load_sweep(int count) {
 TEST_F(MpiRun, AJobStoppedPartWayResumesUnderMpirunWithEachDesignOnce) {
   const fs::path file = write_study("study.json", transient_load_sweep(40));
   const fs::path samples = dir_ / "mpi" / "samples.csv";
-  auto rows_now = [&] { return lines_of(samples); };
   {
     Process p(BEAMRAIL_MPIEXEC,
               mpirun_args(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"}), dir_);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (rows_now() < 4 && p.alive() && std::chrono::steady_clock::now() < deadline)
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    wait_for_lines(p, samples, 4);
     p.kill(SIGTERM);
     const ProcessResult r = p.wait(std::chrono::seconds(60));
     std::printf("stopped: %s\n%s", r.how.c_str(), r.err.c_str());
   }
-  const size_t kept = rows_now();
+  const size_t kept = lines_of(samples);
   EXPECT_GE(kept, 4u);
   const Json summary = resume_and_compare(file, 40);
   EXPECT_EQ(summary["resumed_from_table"].get<size_t>() + summary["evaluated_now"].get<size_t>(),
@@ -353,16 +358,13 @@ TEST_F(MpiRun, AJobStoppedPartWayResumesUnderMpirunWithEachDesignOnce) {
 TEST_F(MpiRun, AJobKilledWholeResumesUnderMpirunWithNothingLostOrDuplicated) {
   const fs::path file = write_study("study.json", transient_load_sweep(120));
   const fs::path samples = dir_ / "mpi" / "samples.csv";
-  auto lines_now = [&] { return lines_of(samples); };
   {
     Process p(BEAMRAIL_MPIEXEC,
               mpirun_args(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"}), dir_);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (lines_now() < 11 && p.alive() && std::chrono::steady_clock::now() < deadline)
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    wait_for_lines(p, samples, 11);
     ASSERT_NO_FATAL_FAILURE(kill_whole_job(p));
   }
-  const size_t kept = lines_now();  // the header and the whole rows
+  const size_t kept = lines_of(samples);  // the header and the whole rows
   EXPECT_GE(kept, 11u);
   ASSERT_LT(kept, 121u) << "the job was meant to be killed part-way";
   const Json summary = resume_and_compare(file, 120);

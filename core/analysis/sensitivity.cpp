@@ -7,7 +7,9 @@
 
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
+#include "core/model/model_numbers.hpp"
 #include "core/model/rotation.hpp"
+#include "core/model/wrench_assembly.hpp"
 
 namespace beamrail {
 
@@ -17,7 +19,65 @@ Vec4 conjugate(const Vec4& q) { return Vec4(q(0), -q(1), -q(2), -q(3)); }
 
 Vec4 unit(const Vec4& q) { return q / q.norm(); }
 
+using HVec = Eigen::Matrix<HyperDual, Eigen::Dynamic, 1>;
+
 }  // namespace
+
+std::vector<Pose<HyperDual>> dual_poses(const Model& base, const Data& data,
+                                        const DualModel& direction, const Eigen::VectorXd& v,
+                                        const Eigen::VectorXd& phi) {
+  using H = HyperDual;
+  std::vector<Pose<H>> out(base.bodies.size());
+  for (size_t i = 0; i < base.bodies.size(); ++i) {
+    const Mat3 relative =
+        data.pose[i].A * rotation_matrix<double>(base.bodies[i].orientation).transpose();
+    Pose<H>& p = out[i];
+    p.A = relative.cast<H>() * rotation_matrix<H>(direction.bodies[i].orientation);
+    p.u = data.pose[i].u.cast<H>();
+    p.v = Vec3T<H>::Zero();
+    p.omega = Vec3T<H>::Zero();
+    const int k = base.bodies[i].free_index;
+    if (k < 0) continue;
+    // Moved by e x = e (dc, theta): c + e dc and (I + e [theta]x) A, exact for e^2 = 0.
+    const auto move = [&](const Eigen::VectorXd& x, bool e1) {
+      if (x.size() == 0) return;
+      Vec3T<H> dc, theta;
+      for (int r = 0; r < 3; ++r) {
+        const double c = x(kDofsPerBody * k + r), t = x(kDofsPerBody * k + 3 + r);
+        dc(r) = e1 ? H(0.0, c, 0.0, 0.0) : H(0.0, 0.0, c, 0.0);
+        theta(r) = e1 ? H(0.0, t, 0.0, 0.0) : H(0.0, 0.0, t, 0.0);
+      }
+      p.u += dc;
+      p.A = (Mat3T<H>::Identity() + skew<H>(theta)) * p.A;
+    };
+    move(v, false);
+    move(phi, true);
+  }
+  return out;
+}
+
+DualModel design_direction(const Model& base, const Model& plus, const Model& minus, double h) {
+  return zip_numbers<HyperDual>(
+      [h](double x, double p, double m) {
+        return HyperDual(x, 0.0, p == m ? 0.0 : (p - m) / (2.0 * h), 0.0);
+      },
+      base, plus, minus);
+}
+
+HVec dual_generalized_forces(const Model& base, const Data& data, const DualModel& direction,
+                             const Eigen::VectorXd& v, const Eigen::VectorXd& phi, double t,
+                             double load_factor) {
+  if (direction.bodies.size() != base.bodies.size() || direction.n_dofs != base.n_dofs)
+    throw std::invalid_argument("dual_generalized_forces: the models have different bodies");
+  const std::vector<Pose<HyperDual>> poses = dual_poses(base, data, direction, v, phi);
+  std::vector<Vec6T<HyperDual>> wrench(base.bodies.size(), Vec6T<HyperDual>::Zero());
+  add_load_wrenches(direction, poses, t, load_factor, wrench);
+  add_element_wrenches(direction, poses, wrench);
+  HVec out(base.n_dofs);
+  for (int k = 0; k < base.n_free(); ++k)
+    out.segment<6>(kDofsPerBody * k) = wrench[base.free_bodies[k]];
+  return out;
+}
 
 void transplant_state(const Model& from_model, const Data& from, const Model& to_model, Data& to) {
   if (from_model.n_dofs != to_model.n_dofs || from_model.bodies.size() != to_model.bodies.size())
@@ -66,12 +126,11 @@ EquilibriumSensitivity::~EquilibriumSensitivity() = default;
 
 Eigen::VectorXd EquilibriumSensitivity::state_derivative(const DesignStep& step) const {
   if (!failure_.empty()) return {};
-  const auto wrench_at = [&](const Model& m) {
-    Data d = moved_state(model_, data_, m, {});
-    compute_wrenches(m, d, t_, load_factor_);
-    return wrench_vector(m, d);
-  };
-  const Eigen::VectorXd dw = (wrench_at(*step.plus) - wrench_at(*step.minus)) / (2.0 * step.h);
+  if (!step.direction) throw std::invalid_argument("state_derivative: no design direction");
+  const HVec w = dual_generalized_forces(model_, data_, *step.direction, Eigen::VectorXd(),
+                                         Eigen::VectorXd(), t_, load_factor_);
+  Eigen::VectorXd dw(w.size());
+  for (Eigen::Index r = 0; r < w.size(); ++r) dw(r) = w(r).b;
   // W(u(p), p) = 0: S du/dp + dW/dp = 0.
   Eigen::VectorXd v = factor_->lu.solve(-dw);
   return v;
@@ -149,20 +208,30 @@ EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data
                                              double t, double load_factor,
                                              const std::vector<double>& lambdas,
                                              const Eigen::MatrixXd& shapes) {
-  // K Phi and M Phi at the states moved along the design direction, from the tangent's blocks.
-  const auto products_at = [&](const Model& m, double sign, Eigen::MatrixXd& k_phi,
-                               Eigen::MatrixXd& m_phi) {
-    Data d = moved_state(base_model, base, m, scaled(v, sign * step.h));
-    compute_wrenches(m, d, t, load_factor);
-    compute_tangent(m, d, t, false, load_factor);
-    k_phi = symmetric_stiffness_product(m, d, shapes);
-    m_phi = mass_product(m, d, shapes);
-  };
-  Eigen::MatrixXd kp, mp, km, mm;
-  products_at(*step.plus, 1.0, kp, mp);
-  products_at(*step.minus, -1.0, km, mm);
-  const Eigen::MatrixXd dk_phi = (kp - km) / (2.0 * step.h);
-  const Eigen::MatrixXd dm_phi = (mp - mm) / (2.0 * step.h);
+  // d/dp (K phi) and d/dp (M phi) along the design direction (through du/dp too), exact: the
+  // e1 e2 part of the generalized forces seeded with phi, and the e2 part of M phi.
+  if (!step.direction) throw std::invalid_argument("eigenvalue_derivatives: no design direction");
+  const DualModel& direction = *step.direction;
+  const int n = static_cast<int>(shapes.cols());
+  Eigen::MatrixXd dk_phi(base_model.n_dofs, n), dm_phi(base_model.n_dofs, n);
+  const std::vector<Pose<HyperDual>> poses = dual_poses(base_model, base, direction, v, {});
+  for (int j = 0; j < n; ++j) {
+    const Eigen::VectorXd phi = shapes.col(j);
+    const HVec w = dual_generalized_forces(base_model, base, direction, v, phi, t, load_factor);
+    for (Eigen::Index r = 0; r < w.size(); ++r) dk_phi(r, j) = -w(r).ab;
+    for (int k = 0; k < base_model.n_free(); ++k) {
+      const int i = base_model.free_bodies[k];
+      const BodyT<HyperDual>& b = direction.bodies[i];
+      const Mat3T<HyperDual> j_global = poses[i].A * b.inertia * poses[i].A.transpose();
+      const int o = kDofsPerBody * k;
+      const Vec3T<HyperDual> translation = b.mass * phi.segment<3>(o).cast<HyperDual>();
+      const Vec3T<HyperDual> rotation = j_global * phi.segment<3>(o + 3).cast<HyperDual>();
+      for (int r = 0; r < 3; ++r) {
+        dm_phi(o + r, j) = translation(r).b;
+        dm_phi(o + 3 + r, j) = rotation(r).b;
+      }
+    }
+  }
   return cluster_derivatives(lambdas, [&](int first, int last, double mean) {
     const int size = last - first + 1;
     const auto phi = shapes.middleCols(first, size);

@@ -5,11 +5,15 @@
 // values: everything the scene build derives from the numbers of the study file). The state is the
 // bodies' displacements from their reference positions and their rotations from their initial
 // orientations, so a state can be carried from the model at p to the model at p + h unchanged
-// (transplant_state). The partial derivatives at a fixed state, dW/dp of the generalized forces and
-// d/dp of phi^T K phi and phi^T M phi, come from the models at p + h and p - h (central
-// differences of the model's quantities at one fixed state: smooth functions of p, evaluated to
-// rounding, so the steps can be small; no analysis is repeated). Everything that depends on the
-// state follows the exact formulas:
+// (transplant_state). The partial derivatives at a fixed state of the generalized forces W and
+// of the products K phi and M phi are exact: the element kernels, the loads and the masses run on
+// hyper-dual numbers (core/model/hyper_dual.hpp) over the model along the design direction (a
+// DualModel: each number's value and its derivative dm/dp), with the state seeded by its own
+// derivative du/dp and, for K phi, by the mode phi. The DualModel's derivatives dm/dp come from
+// the models built at p + h and p - h (design_direction), as do those of the buckling factors and
+// of the responses read from an equilibrium (central differences of the models' quantities at one
+// fixed state: smooth in p and evaluated to rounding, so the steps can be small; no analysis is
+// repeated). Everything that depends on the state follows the exact formulas:
 //
 //  - static equilibrium W(u(p), p) = 0: du/dp = -S^-1 dW/dp|_u with S = dW/du the tangent at the
 //    equilibrium (one solve per parameter with one factorization);
@@ -34,6 +38,7 @@
 
 #include "core/analysis/buckling_analysis.hpp"
 #include "core/model/data.hpp"
+#include "core/model/hyper_dual.hpp"
 #include "core/model/model.hpp"
 
 namespace beamrail {
@@ -54,12 +59,38 @@ void transplant_state(const Model& from_model, const Data& from, const Model& to
 Data moved_state(const Model& base_model, const Data& base, const Model& model,
                  const Eigen::VectorXd& increment);
 
-// The models at p + h and p - h.
+// The model along the design direction: every number's value, and in its e2 part its derivative
+// with respect to the design parameter (its e1 and e1 e2 parts zero).
+using DualModel = ModelT<HyperDual>;
+
+// The DualModel of `base` from the models at p + h and p - h: the values of base, the derivatives
+// (plus - minus) / 2h (0 where plus and minus agree, infinite travel limits included).
+DualModel design_direction(const Model& base, const Model& plus, const Model& minus, double h);
+
+// The models at p + h and p - h, and the model along the design direction.
 struct DesignStep {
   const Model* plus = nullptr;
   const Model* minus = nullptr;
   double h = 0.0;
+  const DualModel* direction = nullptr;
 };
+
+// The poses of every body on hyper-dual numbers over `direction`: the state of `data` (a Data of
+// `base`, the value of `direction`: each body's displacement, and its rotation from its initial
+// orientation applied to the dual model's initial orientation), the free bodies moved by e2 v and
+// then by e1 phi (dim n_dofs each, or empty), at rest.
+std::vector<Pose<HyperDual>> dual_poses(const Model& base, const Data& data,
+                                        const DualModel& direction, const Eigen::VectorXd& v,
+                                        const Eigen::VectorXd& phi);
+
+// The generalized forces (dim n_dofs, 6 per free body as wrench_vector) of `direction` at the
+// state of `data` (a Data of `base`, the value of `direction`) moved by e2 v (v = du/dp, or empty)
+// and then by e1 phi (a mode, or empty), at rest, at time t with the loads scaled by load_factor:
+// their e2 part is dW/dp along the design direction, their e1 e2 part d/dp (dW/du phi) =
+// -(dK/dp) phi.
+Eigen::Matrix<HyperDual, Eigen::Dynamic, 1> dual_generalized_forces(
+    const Model& base, const Data& data, const DualModel& direction, const Eigen::VectorXd& v,
+    const Eigen::VectorXd& phi, double t, double load_factor);
 
 // du/dp of a static equilibrium: factors the tangent once, then one solve per parameter.
 class EquilibriumSensitivity {

@@ -10,10 +10,11 @@
 namespace beamrail {
 
 // The beam's force law on s = (xi, phi): delta = s - (l, 0, 0, 0, 0, 0); g = K2 delta (energy) or
-// p1 = K1 delta, p2 = K2 delta (paper). The coefficients are constants (the length is fixed).
-template <class S>
-LocalForces<S> beam_law(const Beam& beam, const Vec6T<S>& s) {
-  const StiffnessBlocks<double> k(beam.ea, beam.gj, beam.eiy, beam.eiz, beam.ends.length);
+// p1 = K1 delta, p2 = K2 delta (paper). The coefficients are constants (the length is fixed). The
+// beam's numbers are of a scalar P: double, or S itself (design sensitivities).
+template <class P, class S>
+LocalForces<S> beam_law(const BeamT<P>& beam, const Vec6T<S>& s) {
+  const StiffnessBlocks<P> k(beam.ea, beam.gj, beam.eiy, beam.eiz, beam.ends.length);
   Vec6T<S> d = s;
   d(0) = d(0) - beam.ends.length;
   LocalForces<S> out;
@@ -38,11 +39,11 @@ inline bool beam_out_of_range(const Beam& beam, const ElementFrames<double>& f) 
 // Adds the beam's wrenches (force, moment about the centre of mass; global) on body 1 and body 2
 // to w1 and w2 and returns its strain energy 1/2 delta^T K2 delta [J]. For doubles, sets
 // *out_of_range (when given) if the configuration is outside the law's range.
-template <class T>
-T beam_wrenches(const Beam& beam, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
-                bool* out_of_range = nullptr) {
+template <class P, class T>
+T beam_wrenches(const BeamT<P>& beam, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1,
+                Vec6T<T>& w2, bool* out_of_range = nullptr) {
   const ElementFrames<T> f = element_frames(beam.ends, b1, b2, rotation_measure(beam));
-  if constexpr (std::is_same_v<T, double>)
+  if constexpr (std::is_same_v<T, double> && std::is_same_v<P, double>)
     if (out_of_range && beam_out_of_range(beam, f)) *out_of_range = true;
   Vec6T<T> s;
   s << f.xi, f.phi;
@@ -54,7 +55,7 @@ T beam_wrenches(const Beam& beam, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>
     apply_paper_end_wrenches(f, law.p1, law.p2, w1, w2);
   // Damping as the gradient of the dissipation function 1/2 beta rate^T K2 rate: never adds energy.
   if (beam.damping > 0.0) {
-    const StiffnessBlocks<double> k(beam.ea, beam.gj, beam.eiy, beam.eiz, beam.ends.length);
+    const StiffnessBlocks<P> k(beam.ea, beam.gj, beam.eiy, beam.eiz, beam.ends.length);
     g += beam.damping * k.k2(deformation_rate(f, b1, b2));
   }
   apply_deformation_gradient(f, g, w1, w2);
@@ -62,8 +63,8 @@ T beam_wrenches(const Beam& beam, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>
 }
 
 // Deformation delta = (u, phi) of a beam: u = xi - (l, 0, 0).
-template <class T>
-Vec6T<T> beam_deformation(const Beam& beam, const ElementFrames<T>& f) {
+template <class P, class T>
+Vec6T<T> beam_deformation(const BeamT<P>& beam, const ElementFrames<T>& f) {
   Vec6T<T> d;
   d << f.xi(0) - beam.ends.length, f.xi(1), f.xi(2), f.phi(0), f.phi(1), f.phi(2);
   return d;

@@ -40,11 +40,13 @@ enum class RotationMeasure {
   kRotationVector,   // the rotation vector log(a) (energy-law beams)
 };
 
-inline RotationMeasure rotation_measure(const Beam& beam) {
+template <class P>
+RotationMeasure rotation_measure(const BeamT<P>& beam) {
   return beam.formulation == Formulation::kEnergy ? RotationMeasure::kRotationVector
                                                   : RotationMeasure::kAngles;
 }
-inline RotationMeasure rotation_measure(const Rail& rail) {
+template <class P>
+RotationMeasure rotation_measure(const RailT<P>& rail) {
   return rail.type == RailType::kCylindrical ? RotationMeasure::kAnglesTwistFree
                                              : RotationMeasure::kAngles;
 }
@@ -158,8 +160,9 @@ void relative_rotation(const Mat3T<T>& a, RotationMeasure measure, Vec3T<T>& phi
     relative_angles(a, measure == RotationMeasure::kAnglesTwistFree, phi, t);
 }
 
-template <class T>
-ElementFrames<T> element_frames(const ElementEnds& ends, const Pose<T>& b1, const Pose<T>& b2,
+// The ends' numbers are of a scalar P: double, or the scalar T of the poses (design sensitivities).
+template <class P, class T>
+ElementFrames<T> element_frames(const ElementEndsT<P>& ends, const Pose<T>& b1, const Pose<T>& b2,
                                 RotationMeasure measure) {
   ElementFrames<T> f;
   f.E1 = b1.A * ends.frame1;

@@ -4,30 +4,11 @@
 #include "core/model/element_tangent.hpp"
 #include "core/model/joint.hpp"
 #include "core/model/rail.hpp"
+#include "core/model/wrench_assembly.hpp"
 
 namespace beamrail {
-// The load's force or torque at time t in global axes: a follower load's value is in body axes
-// and turns with the body.
-Vec3 load_value(const Load& load, const Pose<double>& pose, double t, double load_factor) {
-  const Vec3 value = load_factor * load.time(t) * load.value;
-  return load.follows ? Vec3(pose.A * value) : value;
-}
-
 void add_load_wrenches(const Model& model, Data& data, double t, double load_factor) {
-  for (int i : model.free_bodies)
-    data.wrench[i].head<3>() += load_factor * model.bodies[i].mass * model.gravity;
-  for (const Load& load : model.loads) {
-    const Pose<double>& pose = data.pose[load.body];
-    const Vec3 value = load_value(load, pose, t, load_factor);
-    Vec6& w = data.wrench[load.body];
-    if (load.kind == LoadKind::kForce) {
-      const Vec3 lever = pose.A * load.offset;
-      w.head<3>() += value;
-      w.tail<3>() += lever.cross(value);
-    } else {
-      w.tail<3>() += value;
-    }
-  }
+  add_load_wrenches(model, data.pose, t, load_factor, data.wrench);
 }
 
 void add_load_stiffness(const Model& model, Data& data, double t, double load_factor) {
@@ -73,25 +54,10 @@ void scatter(const std::array<int, 4>& blocks, const Mat12& j, std::vector<Mat6>
 void compute_wrenches(const Model& model, Data& data, double t, double load_factor) {
   for (Vec6& w : data.wrench) w.setZero();
   add_load_wrenches(model, data, t, load_factor);
-  double energy = 0.0;
   bool out = false;
-  for (const Beam& e : model.beams) {
-    const int i1 = e.ends.body1, i2 = e.ends.body2;
-    energy +=
-        beam_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2], &out);
-  }
-  for (size_t r = 0; r < model.rails.size(); ++r) {
-    const Rail& e = model.rails[r];
-    const int i1 = e.ends.body1, i2 = e.ends.body2;
-    bool floored = false;
-    energy += rail_wrenches(e, data.pose[i1], data.pose[i2], data.wrench[i1], data.wrench[i2],
-                            &floored, &out);
-    data.rail_floored[r] = floored;
-    if (floored) data.rail_floored_ever[r] = 1;
-  }
-  for (const Joint& j : model.joints)
-    energy += joint_wrenches(j, data.pose[j.body1], data.pose[j.body2], data.wrench[j.body1],
-                             data.wrench[j.body2]);
+  const double energy = add_element_wrenches(model, data.pose, data.wrench, &data.rail_floored, &out);
+  for (size_t r = 0; r < model.rails.size(); ++r)
+    if (data.rail_floored[r]) data.rail_floored_ever[r] = 1;
   data.elastic_energy = energy;
   data.out_of_range = out;
   ++data.n_wrench_evaluations;

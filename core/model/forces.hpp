@@ -31,10 +31,6 @@ void add_load_wrenches(const Model& model, Data& data, double t, double load_fac
 // symmetric). Gravity acts at the centres and adds none.
 void add_load_stiffness(const Model& model, Data& data, double t, double load_factor);
 
-// The load's force or torque at time t, scaled by load_factor, in global axes in the pose given
-// (a follower load's body-axes value turned by pose.A).
-Vec3 load_value(const Load& load, const Pose<double>& pose, double t, double load_factor = 1.0);
-
 // Whether the load has a potential: a force of fixed direction. A torque of fixed direction and a
 // follower load have none (their work depends on the path) and make the tangent non-symmetric.
 bool is_conservative(const Load& load);

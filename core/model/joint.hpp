@@ -16,10 +16,12 @@
 namespace beamrail {
 
 // Adds the joint's wrenches on bodies 1 and 2 to w1 and w2 and returns its energy [J].
-template <class T>
-T joint_wrenches(const Joint& j, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2) {
-  const Vec3T<T> lever1 = b1.A * j.r1.cast<T>(), lever2 = b2.A * j.r2.cast<T>();
-  const Vec3T<T> gap = j.centre_offset.cast<T>() + b2.u + lever2 - b1.u - lever1;
+// The joint's numbers are of a scalar P: double, or T itself (design sensitivities).
+template <class P, class T>
+T joint_wrenches(const JointT<P>& j, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1,
+                 Vec6T<T>& w2) {
+  const Vec3T<T> lever1 = b1.A * j.r1.template cast<T>(), lever2 = b2.A * j.r2.template cast<T>();
+  const Vec3T<T> gap = j.centre_offset.template cast<T>() + b2.u + lever2 - b1.u - lever1;
   const Vec3T<T> f2 = -j.k_force * gap;  // the force on body 2 at its joint point
   w2.template head<3>() += f2;
   w2.template tail<3>() += lever2.cross(f2);
@@ -30,9 +32,10 @@ T joint_wrenches(const Joint& j, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>&
   // U = c (1 - a1.a2): a turn dtheta2 of body 2 changes it by -c dtheta2.(a2 x a1), so the moment
   // on body 2 is c a2 x a1, and on body 1 c a1 x a2.
   const int columns = j.type == JointType::kRevolute ? 1 : 3;
-  const double c = j.type == JointType::kRevolute ? j.k_moment : 0.5 * j.k_moment;
+  const P c = j.type == JointType::kRevolute ? j.k_moment : P(0.5 * j.k_moment);
   for (int i = 0; i < columns; ++i) {
-    const Vec3T<T> a1 = b1.A * j.frame1.col(i).cast<T>(), a2 = b2.A * j.frame2.col(i).cast<T>();
+    const Vec3T<T> a1 = b1.A * j.frame1.col(i).template cast<T>();
+    const Vec3T<T> a2 = b2.A * j.frame2.col(i).template cast<T>();
     const Vec3T<T> m2 = c * a2.cross(a1);
     w2.template tail<3>() += m2;
     w1.template tail<3>() -= m2;

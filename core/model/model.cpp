@@ -23,7 +23,8 @@ std::array<int, 4> couple(const std::vector<Body>& bodies,
 
 }  // namespace
 
-void Model::finalize() {
+template <>
+void ModelT<double>::finalize() {
   free_bodies.clear();
   for (int i = 0; i < static_cast<int>(bodies.size()); ++i) {
     Body& b = bodies[i];

@@ -14,109 +14,130 @@
 
 namespace beamrail {
 
-struct Body {
+// The model's numbers are of a scalar type S: double for every analysis, a dual number for design
+// sensitivities (core/analysis/sensitivity.hpp: the scene built on dual numbers carries the
+// derivatives of every number with respect to a design parameter).
+template <class S>
+struct BodyT {
   std::string name;
-  double mass = 0.0;                     // kg (0 for fixed bodies that were given none)
-  Mat3 inertia = Mat3::Zero();           // about the centre of mass, body axes [kg m^2]
-  Mat3 inertia_inverse = Mat3::Zero();   // its inverse (free bodies only)
-  Vec3 position = Vec3::Zero();          // initial centre of mass, global [m]
-  Vec4 orientation = Vec4(1, 0, 0, 0);   // initial Euler parameters (body -> global)
-  Vec3 velocity = Vec3::Zero();          // initial velocity of the centre of mass, global [m/s]
-  Vec3 angular_velocity = Vec3::Zero();  // initial angular velocity, body axes [rad/s]
+  S mass = 0.0;                                 // kg (0 for fixed bodies that were given none)
+  Mat3T<S> inertia = Mat3T<S>::Zero();          // about the centre of mass, body axes [kg m^2]
+  Mat3T<S> inertia_inverse = Mat3T<S>::Zero();  // its inverse (free bodies only)
+  Vec3T<S> position = Vec3T<S>::Zero();         // initial centre of mass, global [m]
+  Vec4T<S> orientation = Vec4T<S>(1, 0, 0, 0);  // initial Euler parameters (body -> global)
+  Vec3T<S> velocity = Vec3T<S>::Zero();  // initial velocity of the centre of mass, global [m/s]
+  Vec3T<S> angular_velocity = Vec3T<S>::Zero();  // initial angular velocity, body axes [rad/s]
   bool fixed = false;
-  bool generated = false;      // interior body of a segmented beam
-  double declared_mass = 0.0;  // the mass given in the scene, before segment masses
-  int free_index = -1;         // position among the free bodies, -1 if fixed
+  bool generated = false;  // interior body of a segmented beam
+  S declared_mass = 0.0;   // the mass given in the scene, before segment masses
+  int free_index = -1;     // position among the free bodies, -1 if fixed
 };
+using Body = BodyT<double>;
 
 // Where an element attaches to its two bodies; computed once at set-up (docs/model.md).
-struct ElementEnds {
-  int body1 = 0, body2 = 0;           // body indices
-  Vec3 r1 = Vec3::Zero();             // point 1 in body-1 axes, from its centre of mass [m]
-  Vec3 r2 = Vec3::Zero();             // point 2 in body-2 axes [m]
-  Mat3 frame1 = Mat3::Identity();     // element frame in body-1 axes (A_bl_1)
-  Mat3 frame2 = Mat3::Identity();     // element frame in body-2 axes (A_bl_2)
-  Vec3 centre_offset = Vec3::Zero();  // c2 - c1 of the bodies' reference centres, global [m]
-  double length = 0.0;                // |p2 - p1| in the initial configuration [m]
+template <class S>
+struct ElementEndsT {
+  int body1 = 0, body2 = 0;                // body indices
+  Vec3T<S> r1 = Vec3T<S>::Zero();          // point 1 in body-1 axes, from its centre of mass [m]
+  Vec3T<S> r2 = Vec3T<S>::Zero();          // point 2 in body-2 axes [m]
+  Mat3T<S> frame1 = Mat3T<S>::Identity();  // element frame in body-1 axes (A_bl_1)
+  Mat3T<S> frame2 = Mat3T<S>::Identity();  // element frame in body-2 axes (A_bl_2)
+  Vec3T<S> centre_offset =
+      Vec3T<S>::Zero();  // c2 - c1 of the bodies' reference centres, global [m]
+  S length = 0.0;        // |p2 - p1| in the initial configuration [m]
 };
+using ElementEnds = ElementEndsT<double>;
 
 // Which of the two force laws of docs/model.md an element uses.
 enum class Formulation { kEnergy, kPaper };
 
 // Cross-section properties kept for stress recovery and mass.
-struct SectionProperties {
-  double area = 0.0;              // S [m^2]
-  double torsion_constant = 0.0;  // Ix [m^4]
-  double iy = 0.0, iz = 0.0;      // second moments about local y and z [m^4]
-  double wy = 0.0, wz = 0.0;      // section moduli about y and z [m^3]; 0 when unknown
+template <class S>
+struct SectionPropertiesT {
+  S area = 0.0;              // S [m^2]
+  S torsion_constant = 0.0;  // Ix [m^4]
+  S iy = 0.0, iz = 0.0;      // second moments about local y and z [m^4]
+  S wy = 0.0, wz = 0.0;      // section moduli about y and z [m^3]; 0 when unknown
 };
+using SectionProperties = SectionPropertiesT<double>;
 
-struct Beam {
+template <class S>
+struct BeamT {
   std::string name;
-  ElementEnds ends;
-  double ea = 0.0;              // E S [N]
-  double gj = 0.0;              // G Ix [N m^2]
-  double eiy = 0.0, eiz = 0.0;  // E Iy, E Iz [N m^2]
-  double damping = 0.0;         // stiffness-proportional beta [s]
+  ElementEndsT<S> ends;
+  S ea = 0.0;              // E S [N]
+  S gj = 0.0;              // G Ix [N m^2]
+  S eiy = 0.0, eiz = 0.0;  // E Iy, E Iz [N m^2]
+  S damping = 0.0;         // stiffness-proportional beta [s]
   Formulation formulation = Formulation::kEnergy;
-  SectionProperties section;
-  double density = 0.0;  // kg/m^3, 0 when not given
-  std::string group;     // the scene beam this element models (its own name if unsplit)
-  int segment = 0;       // 1..n for the segments of a split beam, 0 otherwise
+  SectionPropertiesT<S> section;
+  S density = 0.0;    // kg/m^3, 0 when not given
+  std::string group;  // the scene beam this element models (its own name if unsplit)
+  int segment = 0;    // 1..n for the segments of a split beam, 0 otherwise
 };
+using Beam = BeamT<double>;
 
 enum class RailType { kPrismatic, kCylindrical };
 
 // A rail fixed to body 1 along its local x, on which body 2 (the carriage) slides.
-struct Rail {
+template <class S>
+struct RailT {
   std::string name;
   RailType type = RailType::kPrismatic;
-  ElementEnds ends;             // ends.length: the initial carriage distance
-  double gj = 0.0;              // G Ix; 0 for cylindrical rails [N m^2]
-  double eiy = 0.0, eiz = 0.0;  // [N m^2]
-  double min_length = 0.0;      // floor of |l| [m]
+  ElementEndsT<S> ends;    // ends.length: the initial carriage distance
+  S gj = 0.0;              // G Ix; 0 for cylindrical rails [N m^2]
+  S eiy = 0.0, eiz = 0.0;  // [N m^2]
+  S min_length = 0.0;      // floor of |l| [m]
   // The carriage's axial coordinate l (from point 1 along the rail's x) must stay within
   // [travel_min, travel_max]: the rail's extent [m]; unbounded when not given.
-  double travel_min = -std::numeric_limits<double>::infinity();
-  double travel_max = std::numeric_limits<double>::infinity();
-  double damping = 0.0;  // [s]
+  S travel_min = -std::numeric_limits<double>::infinity();
+  S travel_max = std::numeric_limits<double>::infinity();
+  S damping = 0.0;  // [s]
   Formulation formulation = Formulation::kEnergy;
-  SectionProperties section;
-  double density = 0.0;
+  SectionPropertiesT<S> section;
+  S density = 0.0;
 };
+using Rail = RailT<double>;
 
 enum class JointType { kSpherical, kRevolute, kFixed };
 
 // A joint between two bodies, modelled as a stiff penalty element (core/model/joint.hpp,
 // docs/model.md "Joints"): spherical keeps the two bodies' joint points together, revolute also
 // keeps their axes aligned, fixed also keeps their frames aligned.
-struct Joint {
+template <class S>
+struct JointT {
   std::string name;
   JointType type = JointType::kSpherical;
   int body1 = 0, body2 = 0;
-  Vec3 r1 = Vec3::Zero(), r2 = Vec3::Zero();  // the joint point in body axes, from the centres [m]
+  // The joint point in body axes, from the centres [m].
+  Vec3T<S> r1 = Vec3T<S>::Zero(), r2 = Vec3T<S>::Zero();
   // The joint frame in each body's axes (equal in global axes initially); column 0 is the axis.
-  Mat3 frame1 = Mat3::Identity(), frame2 = Mat3::Identity();
-  Vec3 centre_offset = Vec3::Zero();  // c2 - c1 of the bodies' reference centres, global [m]
-  double relative_compliance = 1e-6;  // the penalty stiffness is the scene's scale over this
-  double k_force = 0.0;               // [N/m]
-  double k_moment = 0.0;              // [N m/rad]
+  Mat3T<S> frame1 = Mat3T<S>::Identity(), frame2 = Mat3T<S>::Identity();
+  Vec3T<S> centre_offset =
+      Vec3T<S>::Zero();          // c2 - c1 of the bodies' reference centres, global [m]
+  S relative_compliance = 1e-6;  // the penalty stiffness is the scene's scale over this
+  S k_force = 0.0;               // [N/m]
+  S k_moment = 0.0;              // [N m/rad]
 };
+using Joint = JointT<double>;
 
 enum class LoadKind { kForce, kTorque };
 
-struct Load {
+template <class S>
+struct LoadT {
   LoadKind kind = LoadKind::kForce;
   int body = 0;
-  Vec3 offset = Vec3::Zero();  // force: point of application in body axes, from the centre [m]
+  Vec3T<S> offset =
+      Vec3T<S>::Zero();  // force: point of application in body axes, from the centre [m]
   // [N] or [N m], scaled by time(t): in global axes, or in body axes when `follows`
-  Vec3 value = Vec3::Zero();
+  Vec3T<S> value = Vec3T<S>::Zero();
   // A follower load: its value is fixed in the body frame and turns with the body (global value
   // A value); otherwise its direction stays fixed in global axes.
   bool follows = false;
   TimeFunction time;
   std::string load_case;  // the load case it belongs to; empty: none (applied by every analysis)
 };
+using Load = LoadT<double>;
 
 // Couplings between free bodies: the non-zero 6 x 6 blocks of tangent matrices, computed once.
 struct BlockPattern {
@@ -143,13 +164,14 @@ struct SegmentChoice {
   bool pinned = false;            // true: the count of the study's scene, kept for this design
 };
 
-struct Model {
-  std::vector<Body> bodies;  // [0] is ground
-  std::vector<Beam> beams;
-  std::vector<Rail> rails;
-  std::vector<Joint> joints;
-  std::vector<Load> loads;
-  Vec3 gravity = Vec3::Zero();                 // [m/s^2]
+template <class S>
+struct ModelT {
+  std::vector<BodyT<S>> bodies;  // [0] is ground
+  std::vector<BeamT<S>> beams;
+  std::vector<RailT<S>> rails;
+  std::vector<JointT<S>> joints;
+  std::vector<LoadT<S>> loads;
+  Vec3T<S> gravity = Vec3T<S>::Zero();         // [m/s^2]
   std::vector<std::string> load_cases;         // the names loads give as their case, in scene order
   std::vector<SegmentChoice> segment_choices;  // of the beams with "segments": "auto"
 
@@ -164,20 +186,21 @@ struct Model {
   // once by the scene loader after the element arrays are final.
   void finalize();
 };
+using Model = ModelT<double>;
 
 // The model with only the loads for which keep(load) is true, and with gravity or without. Bodies,
 // elements and the pattern are those of `model` (an analysis of one load case sees the same
 // structure).
-template <class Keep>
-Model with_loads(const Model& model, Keep&& keep, bool gravity) {
-  Model out;
+template <class S, class Keep>
+ModelT<S> with_loads(const ModelT<S>& model, Keep&& keep, bool gravity) {
+  ModelT<S> out;
   out.bodies = model.bodies;
   out.beams = model.beams;
   out.rails = model.rails;
   out.joints = model.joints;
-  for (const Load& load : model.loads)
+  for (const LoadT<S>& load : model.loads)
     if (keep(load)) out.loads.push_back(load);
-  out.gravity = gravity ? model.gravity : Vec3::Zero();
+  out.gravity = gravity ? model.gravity : Vec3T<S>(Vec3T<S>::Zero());
   out.load_cases = model.load_cases;
   out.segment_choices = model.segment_choices;
   out.free_bodies = model.free_bodies;
@@ -189,7 +212,8 @@ Model with_loads(const Model& model, Keep&& keep, bool gravity) {
 
 // The loads an analysis of `load_case` applies: the loads without a case and those of the case
 // ("": the loads without a case only); gravity always.
-inline bool applies_in_case(const Load& load, const std::string& load_case) {
+template <class S>
+bool applies_in_case(const LoadT<S>& load, const std::string& load_case) {
   return load.load_case.empty() || load.load_case == load_case;
 }
 

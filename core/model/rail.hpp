@@ -15,8 +15,9 @@ namespace beamrail {
 
 // Current deformable length from the axial coordinate x = xi_x: l = x with |l| >= min_length.
 // Sets *floored when the floor acts.
-template <class T>
-T rail_length(const Rail& rail, const T& x, bool* floored) {
+// The rail's numbers are of a scalar P: double, or T itself (design sensitivities).
+template <class P, class T>
+T rail_length(const RailT<P>& rail, const T& x, bool* floored) {
   using std::abs;
   if (abs(x) >= rail.min_length) {
     *floored = false;
@@ -31,12 +32,12 @@ T rail_length(const Rail& rail, const T& x, bool* floored) {
 // sign runs linearly from -1 to 1 (x / min_length) instead of jumping at x = 0, so that forces
 // and strain energy stay continuous while the carriage passes point 1 (a jump of the energy there
 // made the energy law gain energy at every pass).
-template <class T>
-StiffnessBlocks<T> rail_stiffness(const Rail& rail, const T& x, const T& l, bool floored) {
-  StiffnessBlocks<T> k(0.0, rail.gj, rail.eiy, rail.eiz, l);
+template <class P, class T>
+StiffnessBlocks<T> rail_stiffness(const RailT<P>& rail, const T& x, const T& l, bool floored) {
+  StiffnessBlocks<T> k(P(0.0), rail.gj, rail.eiy, rail.eiz, l);
   if (floored) {
     const T sign = x / rail.min_length;
-    const double m2 = rail.min_length * rail.min_length;
+    const P m2 = rail.min_length * rail.min_length;
     k.y2 = sign * (6.0 * rail.eiy / m2);
     k.z2 = sign * (6.0 * rail.eiz / m2);
   }
@@ -47,8 +48,8 @@ StiffnessBlocks<T> rail_stiffness(const Rail& rail, const T& x, const T& l, bool
 // cantilever of length l = xi_x. Energy: g = dU/ds, whose first entry is the configurational force
 // dU/dl along the rail (while l is floored, only the blended sign of the couplings depends on x);
 // paper: p1 = K1(l) delta, p2 = K2(l) delta.
-template <class S>
-LocalForces<S> rail_law(const Rail& rail, const Vec6T<S>& s, bool* floored) {
+template <class P, class S>
+LocalForces<S> rail_law(const RailT<P>& rail, const Vec6T<S>& s, bool* floored) {
   const S l = rail_length(rail, S(s(0)), floored);
   const StiffnessBlocks<S> k = rail_stiffness(rail, S(s(0)), l, *floored);
   Vec6T<S> d = s;
@@ -58,7 +59,7 @@ LocalForces<S> rail_law(const Rail& rail, const Vec6T<S>& s, bool* floored) {
     out.g = k.k2(d);
     if (*floored) {
       // U = ... + sign (6 / m^2) (EIy d2 d4 - EIz d1 d5) with sign = x / m.
-      const double m3 = rail.min_length * rail.min_length * rail.min_length;
+      const P m3 = rail.min_length * rail.min_length * rail.min_length;
       out.g(0) = 6.0 * (rail.eiy * d(2) * d(4) - rail.eiz * d(1) * d(5)) / m3;
     } else {
       out.g(0) = (l < 0.0 ? S(-1.0) : S(1.0)) *
@@ -87,11 +88,11 @@ inline bool rail_out_of_range(const Rail& rail, const ElementFrames<double>& f) 
 // Adds the rail's wrenches on body 1 (the rail) and body 2 (the carriage) to w1 and w2 and returns
 // the strain energy 1/2 delta^T K2(l) delta [J]. Sets *floored when |l| hit min_length; for
 // doubles, sets *out_of_range (when given) if the configuration is outside the law's range.
-template <class T>
-T rail_wrenches(const Rail& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1, Vec6T<T>& w2,
-                bool* floored, bool* out_of_range = nullptr) {
+template <class P, class T>
+T rail_wrenches(const RailT<P>& rail, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1,
+                Vec6T<T>& w2, bool* floored, bool* out_of_range = nullptr) {
   const ElementFrames<T> f = element_frames(rail.ends, b1, b2, rotation_measure(rail));
-  if constexpr (std::is_same_v<T, double>)
+  if constexpr (std::is_same_v<T, double> && std::is_same_v<P, double>)
     if (out_of_range && rail_out_of_range(rail, f)) *out_of_range = true;
   Vec6T<T> s;
   s << f.xi, f.phi;

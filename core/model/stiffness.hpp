@@ -18,8 +18,9 @@ struct StiffnessBlocks {
   T y3, y2, y1, y0;  // 12 EIy / L^3, 6 s EIy / L^2, 4 EIy / L, 2 EIy / L
   T z3, z2, z1, z0;  // the same with EIz
 
-  // ea, gj, eiy, eiz: rigidities; length: signed length l with |l| > 0.
-  StiffnessBlocks(double ea, double gj, double eiy, double eiz, const T& length) {
+  // ea, gj, eiy, eiz: rigidities (double, or T itself); length: signed length l with |l| > 0.
+  template <class P>
+  StiffnessBlocks(const P& ea, const P& gj, const P& eiy, const P& eiz, const T& length) {
     using std::abs;
     const T len = abs(length);
     const T s = length < 0.0 ? T(-1) : T(1);
@@ -71,8 +72,8 @@ T strain_energy(const StiffnessBlocks<S>& k, const Vec6T<T>& d) {
 }
 
 // d/d|l| of 1/2 d^T K2(l) d at fixed d, for rigidities without the axial term (rails).
-template <class T>
-T strain_energy_length_derivative(double gj, double eiy, double eiz, const T& length,
+template <class P, class T>
+T strain_energy_length_derivative(const P& gj, const P& eiy, const P& eiz, const T& length,
                                   const Vec6T<T>& d) {
   using std::abs;
   const T len = abs(length);

@@ -9,29 +9,6 @@
 
 namespace beamrail {
 
-double structural_mass(const Model& model) {
-  double m = 0.0;
-  for (const Body& b : model.bodies) m += b.declared_mass;
-  for (const Beam& e : model.beams) m += e.density * e.section.area * e.ends.length;
-  for (const Rail& e : model.rails) m += e.density * e.section.area * e.ends.length;
-  return m;
-}
-
-double mass_response(const Model& model, const ResponseSpec& spec) {
-  if (!spec.subset) return structural_mass(model);
-  double m = 0.0;
-  for (int i : spec.mass_bodies) m += model.bodies[i].declared_mass;
-  for (int i : spec.mass_beams) {
-    const Beam& e = model.beams[i];
-    m += e.density * e.section.area * e.ends.length;
-  }
-  for (int i : spec.mass_rails) {
-    const Rail& e = model.rails[i];
-    m += e.density * e.section.area * e.ends.length;
-  }
-  return m;
-}
-
 PointTracker::PointTracker(const Model& model, const ResponseSpec& spec)
     : body_(spec.body), direction_(spec.direction) {
   const Body& b = model.bodies[spec.body];
@@ -39,9 +16,20 @@ PointTracker::PointTracker(const Model& model, const ResponseSpec& spec)
   offset_ = rotation_matrix<double>(b.orientation).transpose() * initial_lever_;
 }
 
+namespace {
+
+// The displacement along `direction` of the point at `lever` (global, from the centre) in the
+// initial configuration, `offset` in body axes, of a body at pose p.
+template <class S>
+S point_displacement(const Pose<S>& p, const Vec3T<S>& offset, const Vec3T<S>& lever,
+                     const Vec3& direction) {
+  return (p.u + (p.A * offset - lever)).dot(direction.cast<S>());
+}
+
+}  // namespace
+
 double PointTracker::value(const Data& data) const {
-  const Pose<double>& p = data.pose[body_];
-  return (p.u + (p.A * offset_ - initial_lever_)).dot(direction_);
+  return point_displacement(data.pose[body_], offset_, initial_lever_, direction_);
 }
 
 void static_responses(const Study& study, int analysis, const Model& model, const Data& data,
@@ -69,6 +57,57 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
           worst =
               std::max(worst, end_stress(model.beams[i].section, beam_end_forces(model, data, i)));
         values[k] = worst;
+        break;
+      }
+      default:
+        break;
+    }
+  }
+}
+
+void static_response_derivatives(const Study& study, int analysis, const Model& base,
+                                 const Data& data, const DualModel& direction,
+                                 const Eigen::VectorXd& v, std::vector<double>& values) {
+  using H = HyperDual;
+  const std::vector<Pose<H>> pose = dual_poses(base, data, direction, v, Eigen::VectorXd());
+  for (size_t k = 0; k < study.responses.size(); ++k) {
+    const ResponseSpec& r = study.responses[k];
+    if (r.analysis != analysis) continue;
+    switch (r.quantity) {
+      case ResponseSpec::Quantity::kDisplacement: {
+        // Without a point given, the point is the body's centre (which may move with p).
+        const BodyT<H>& b = direction.bodies[r.body];
+        const Vec3T<H> lever =
+            r.point_given ? Vec3T<H>(r.point.cast<H>() - b.position) : Vec3T<H>(Vec3T<H>::Zero());
+        const Vec3T<H> offset = rotation_matrix<H>(b.orientation).transpose() * lever;
+        values[k] = point_displacement(pose[r.body], offset, lever, r.direction).b;
+        break;
+      }
+      case ResponseSpec::Quantity::kRotation: {
+        // The rotation vector from the initial orientation, theta = log(A A0^T): a turn e dtheta
+        // of the body changes it by J(theta)^-1 dtheta (rotation_vector_rate); it does not depend
+        // on A0 itself.
+        const int f = base.bodies[r.body].free_index;
+        values[k] = f < 0 || v.size() == 0
+                        ? 0.0
+                        : rotation_vector_rate(data.rotation[r.body],
+                                               Vec3(v.segment<3>(kDofsPerBody * f + 3)))
+                              .dot(r.direction);
+        break;
+      }
+      case ResponseSpec::Quantity::kElementForce: {
+        const EndForcesT<H> f = r.element.rail ? rail_end_forces(direction, pose, r.element.index)
+                                               : beam_end_forces(direction, pose, r.element.index);
+        values[k] = (r.element.end == 1 ? f.end1 : f.end2)(r.component).b;
+        break;
+      }
+      case ResponseSpec::Quantity::kMaxStress: {
+        H worst = 0.0;
+        for (int i : r.beams) {
+          const H s = end_stress(direction.beams[i].section, beam_end_forces(direction, pose, i));
+          if (s > worst) worst = s;
+        }
+        values[k] = worst.b;
         break;
       }
       default:

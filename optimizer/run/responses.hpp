@@ -6,16 +6,39 @@
 #include <vector>
 
 #include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/sensitivity.hpp"
 #include "core/model/data.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
 
 // Total structural mass: declared body masses plus rho S l of every beam and rail with a density.
-double structural_mass(const Model& model);
+// On the model's scalar (double, or HyperDual for the design sensitivities).
+template <class S>
+S structural_mass(const ModelT<S>& model) {
+  S m = 0.0;
+  for (const BodyT<S>& b : model.bodies) m += b.declared_mass;
+  for (const BeamT<S>& e : model.beams) m += e.density * e.section.area * e.ends.length;
+  for (const RailT<S>& e : model.rails) m += e.density * e.section.area * e.ends.length;
+  return m;
+}
 
 // A mass response: the structural mass, or that of its subset of bodies and elements.
-double mass_response(const Model& model, const ResponseSpec& spec);
+template <class S>
+S mass_response(const ModelT<S>& model, const ResponseSpec& spec) {
+  if (!spec.subset) return structural_mass(model);
+  S m = 0.0;
+  for (int i : spec.mass_bodies) m += model.bodies[i].declared_mass;
+  for (int i : spec.mass_beams) {
+    const BeamT<S>& e = model.beams[i];
+    m += e.density * e.section.area * e.ends.length;
+  }
+  for (int i : spec.mass_rails) {
+    const RailT<S>& e = model.rails[i];
+    m += e.density * e.section.area * e.ends.length;
+  }
+  return m;
+}
 
 // Displacement along a direction of a body point, from the initial configuration.
 class PointTracker {
@@ -34,6 +57,13 @@ class PointTracker {
 // `analysis` (an index into study.analyses) from the equilibrium in data; others are left alone.
 void static_responses(const Study& study, int analysis, const Model& model, const Data& data,
                       std::vector<double>& values);
+
+// The total derivatives along a design direction of the static responses of `analysis`, written
+// where static_responses writes their values: the responses on hyper-dual numbers over
+// `direction` at the equilibrium `data` (of `base`) moved by e2 v (v = du/dp), their e2 parts.
+void static_response_derivatives(const Study& study, int analysis, const Model& base,
+                                 const Data& data, const DualModel& direction,
+                                 const Eigen::VectorXd& v, std::vector<double>& values);
 
 // A mode shape by body name (dc, dtheta of each free body): comparable between designs whose
 // bodies are numbered differently.

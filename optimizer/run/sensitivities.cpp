@@ -127,14 +127,19 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
 
   // du/dp of each equilibrium, on its load case's models.
   std::map<std::string, Eigen::VectorXd> v;
-  std::map<std::string, std::pair<Model, Model>> case_models;
-  const auto models_of = [&](const std::string& load_case) -> const std::pair<Model, Model>& {
+  struct CaseModels {
+    Model plus, minus;
+    DualModel direction;
+    DesignStep step(double h) const { return {&plus, &minus, h, &direction}; }
+  };
+  std::map<std::string, CaseModels> case_models;
+  const auto models_of = [&](const std::string& load_case) -> const CaseModels& {
     auto it = case_models.find(load_case);
-    if (it == case_models.end())
-      it = case_models
-               .emplace(load_case, std::make_pair(case_model_of(plus, load_case),
-                                                  case_model_of(minus, load_case)))
-               .first;
+    if (it == case_models.end()) {
+      CaseModels m{case_model_of(plus, load_case), case_model_of(minus, load_case), {}};
+      m.direction = design_direction(case_model_of(design_, load_case), m.plus, m.minus, h);
+      it = case_models.emplace(load_case, std::move(m)).first;
+    }
     return it->second;
   };
   const auto state_derivative = [&](const std::string& key) -> const Eigen::VectorXd* {
@@ -147,8 +152,7 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
       out.message = s.failure();
       return nullptr;
     }
-    const auto& [mp, mm] = models_of(e.load_case);
-    return &v.emplace(key, s.state_derivative({&mp, &mm, h})).first->second;
+    return &v.emplace(key, s.state_derivative(models_of(e.load_case).step(h))).first->second;
   };
 
   for (size_t i = 0; i < design_.analyses.size(); ++i) {
@@ -165,21 +169,18 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
     const Eigen::VectorXd& du = dv ? *dv : none;
     switch (spec.type) {
       case AnalysisSpec::Type::kStatic: {
-        const auto& [mp, mm] = models_of(spec.load_case);
         const EvaluationStates::Equilibrium& e = states.equilibria.at(a.equilibrium);
-        std::vector<double> up(nr, kNaN), down(nr, kNaN);
-        static_responses(plus, index, mp,
-                         moved_state(*e.model, *e.data, mp, Eigen::VectorXd(h * du)), up);
-        static_responses(minus, index, mm,
-                         moved_state(*e.model, *e.data, mm, Eigen::VectorXd(-h * du)), down);
+        std::vector<double> d(nr, kNaN);
+        static_response_derivatives(design_, index, *e.model, *e.data,
+                                    models_of(spec.load_case).direction, du, d);
         for (int k = 0; k < nr; ++k)
-          if (design_.responses[k].analysis == index) column(k) = (up[k] - down[k]) / (2.0 * h);
+          if (design_.responses[k].analysis == index) column(k) = d[k];
         break;
       }
       case AnalysisSpec::Type::kModal: {
-        const auto& [mp, mm] = models_of(spec.load_case);
-        const EigenvalueDerivatives d = eigenvalue_derivatives(
-            *a.model, *a.data, {&mp, &mm, h}, du, a.time, a.load_factor, a.eigenvalues, a.shapes);
+        const EigenvalueDerivatives d =
+            eigenvalue_derivatives(*a.model, *a.data, models_of(spec.load_case).step(h), du, a.time,
+                                   a.load_factor, a.eigenvalues, a.shapes);
         for (int k = 0; k < nr; ++k) {
           const int m = a.response_mode[k];
           if (m < 0) continue;
@@ -220,9 +221,7 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
   }
   for (int k = 0; k < nr; ++k)
     if (design_.responses[k].quantity == ResponseSpec::Quantity::kMass)
-      column(k) = (mass_response(plus.model, plus.responses[k]) -
-                   mass_response(minus.model, minus.responses[k])) /
-                  (2.0 * h);
+      column(k) = mass_response(models_of("").direction, design_.responses[k]).b;
   return true;
 }
 

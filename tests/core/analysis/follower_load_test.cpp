@@ -612,7 +612,8 @@ TEST(FollowerLoads, StaticSensitivityUnderAFollowerForceMatchesDifferences) {
   const double t = std::numeric_limits<double>::infinity();
   const EquilibriumSensitivity sensitivity(model, data, t);
   ASSERT_EQ(sensitivity.failure(), "");
-  const Eigen::VectorXd du = sensitivity.state_derivative({&plus, &minus, h});
+  const DualModel direction = design_direction(model, plus, minus, h);
+  const Eigen::VectorXd du = sensitivity.state_derivative({&plus, &minus, h, &direction});
   const int k = model.bodies[body_index(model, "tip")].free_index;
   const Vec3 exact = du.segment<3>(6 * k);
   const auto difference = [&](double step) {

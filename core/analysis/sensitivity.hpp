@@ -59,9 +59,9 @@ void transplant_state(const Model& from_model, const Data& from, const Model& to
 Data moved_state(const Model& base_model, const Data& base, const Model& model,
                  const Eigen::VectorXd& increment);
 
-// The model along the design direction: every number's value, and in its e2 part its derivative
-// with respect to the design parameter (its e1 and e1 e2 parts zero).
-using DualModel = ModelT<HyperDual>;
+// A DualModel along the design direction: every number's value, and in its e2 part its derivative
+// with respect to the design parameter (its e1 and e1 e2 parts zero); built by
+// load_dual_scene (core/scene/scene_loader.hpp), or from the models at p +- h.
 
 // The DualModel of `base` from the models at p + h and p - h: the values of base, the derivatives
 // (plus - minus) / 2h (0 where plus and minus agree, infinite travel limits included).

@@ -55,7 +55,8 @@ void compute_wrenches(const Model& model, Data& data, double t, double load_fact
   for (Vec6& w : data.wrench) w.setZero();
   add_load_wrenches(model, data, t, load_factor);
   bool out = false;
-  const double energy = add_element_wrenches(model, data.pose, data.wrench, &data.rail_floored, &out);
+  const double energy =
+      add_element_wrenches(model, data.pose, data.wrench, &data.rail_floored, &out);
   for (size_t r = 0; r < model.rails.size(); ++r)
     if (data.rail_floored[r]) data.rail_floored_ever[r] = 1;
   data.elastic_energy = energy;

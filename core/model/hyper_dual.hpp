@@ -82,7 +82,9 @@ BEAMRAIL_HYPER_DUAL_COMPARE(==)
 BEAMRAIL_HYPER_DUAL_COMPARE(!=)
 #undef BEAMRAIL_HYPER_DUAL_COMPARE
 
+// sqrt at 0 has no derivative: a constant 0 (the norm of a zero vector) stays a constant 0.
 inline HyperDual sqrt(const HyperDual& x) {
+  if (x.v == 0.0 && x.a == 0.0 && x.b == 0.0 && x.ab == 0.0) return {};
   const double r = std::sqrt(x.v);
   return hyper_dual_chain(x, r, 0.5 / r, -0.25 / (r * x.v));
 }
@@ -92,6 +94,10 @@ inline HyperDual sin(const HyperDual& x) {
 }
 inline HyperDual cos(const HyperDual& x) {
   return hyper_dual_chain(x, std::cos(x.v), -std::sin(x.v), -std::cos(x.v));
+}
+inline HyperDual exp(const HyperDual& x) {
+  const double e = std::exp(x.v);
+  return hyper_dual_chain(x, e, e, e);
 }
 // atan2(y, x) with its gradient (x, -y) / r^2 and Hessian [[-2xy, y^2 - x^2], [y^2 - x^2, 2xy]] /
 // r^4 (rows and columns y, x).

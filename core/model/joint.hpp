@@ -49,22 +49,31 @@ T joint_wrenches(const JointT<P>& j, const Pose<T>& b1, const Pose<T>& b2, Vec6T
 // the largest weight or force load over the joints' largest lever (the distance from a joint point
 // to its bodies' centres, 1 m when none): a joint then moves by relative_compliance times that
 // lever under that load.
-inline std::pair<double, double> joint_stiffness_scale(const Model& model) {
-  double kt = 0.0, kr = 0.0;
-  const auto element = [&](double ea, double gj, double eiy, double eiz, double l) {
-    const double ei = std::max(eiy, eiz);
-    kt = std::max({kt, ea / l, 12.0 * ei / (l * l * l)});
-    kr = std::max({kr, gj / l, 4.0 * ei / l});
+template <class S>
+std::pair<S, S> joint_stiffness_scale(const ModelT<S>& model) {
+  S kt = 0.0, kr = 0.0;
+  const auto raise = [](S& to, const S& x) {
+    if (x > to) to = x;
   };
-  for (const Beam& e : model.beams) element(e.ea, e.gj, e.eiy, e.eiz, e.ends.length);
-  for (const Rail& e : model.rails) element(0.0, e.gj, e.eiy, e.eiz, e.ends.length);
+  const auto element = [&](const S& ea, const S& gj, const S& eiy, const S& eiz, const S& l) {
+    const S ei = eiy > eiz ? eiy : eiz;
+    raise(kt, ea / l);
+    raise(kt, 12.0 * ei / (l * l * l));
+    raise(kr, gj / l);
+    raise(kr, 4.0 * ei / l);
+  };
+  for (const BeamT<S>& e : model.beams) element(e.ea, e.gj, e.eiy, e.eiz, e.ends.length);
+  for (const RailT<S>& e : model.rails) element(S(0.0), e.gj, e.eiy, e.eiz, e.ends.length);
   if (kt > 0.0 && kr > 0.0) return {kt, kr};
-  double load = 0.0, lever = 0.0;
-  for (const Body& b : model.bodies)
-    if (!b.fixed) load = std::max(load, b.mass * model.gravity.norm());
-  for (const Load& l : model.loads)
-    if (l.kind == LoadKind::kForce) load = std::max(load, l.value.norm());
-  for (const Joint& j : model.joints) lever = std::max({lever, j.r1.norm(), j.r2.norm()});
+  S load = 0.0, lever = 0.0;
+  for (const BodyT<S>& b : model.bodies)
+    if (!b.fixed) raise(load, b.mass * model.gravity.norm());
+  for (const LoadT<S>& l : model.loads)
+    if (l.kind == LoadKind::kForce) raise(load, l.value.norm());
+  for (const JointT<S>& j : model.joints) {
+    raise(lever, j.r1.norm());
+    raise(lever, j.r2.norm());
+  }
   if (!(lever > 0.0)) lever = 1.0;
   if (!(load > 0.0)) load = 1.0;
   return {load / lever, load * lever};

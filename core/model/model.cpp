@@ -4,11 +4,14 @@
 #include <map>
 #include <utility>
 
+#include "core/model/hyper_dual.hpp"
+
 namespace beamrail {
 namespace {
 
 // Registers the four couplings of an element between bodies a and b.
-std::array<int, 4> couple(const std::vector<Body>& bodies,
+template <class S>
+std::array<int, 4> couple(const std::vector<BodyT<S>>& bodies,
                           std::map<std::pair<int, int>, int>& index,
                           std::vector<BlockPattern::Block>& blocks, int a, int b) {
   const int fa = bodies[a].free_index, fb = bodies[b].free_index;
@@ -23,11 +26,11 @@ std::array<int, 4> couple(const std::vector<Body>& bodies,
 
 }  // namespace
 
-template <>
-void ModelT<double>::finalize() {
+template <class S>
+void ModelT<S>::finalize() {
   free_bodies.clear();
   for (int i = 0; i < static_cast<int>(bodies.size()); ++i) {
-    Body& b = bodies[i];
+    BodyT<S>& b = bodies[i];
     b.free_index = b.fixed ? -1 : static_cast<int>(free_bodies.size());
     if (!b.fixed) free_bodies.push_back(i);
   }
@@ -40,18 +43,21 @@ void ModelT<double>::finalize() {
     index[{k, k}] = k;
     pattern.blocks.push_back({k, k});
   }
-  for (const Beam& e : beams)
+  for (const BeamT<S>& e : beams)
     pattern.beam_blocks.push_back(
         couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
-  for (const Rail& e : rails)
+  for (const RailT<S>& e : rails)
     pattern.rail_blocks.push_back(
         couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
-  for (const Joint& e : joints)
+  for (const JointT<S>& e : joints)
     pattern.joint_blocks.push_back(couple(bodies, index, pattern.blocks, e.body1, e.body2));
   pattern.transposed.resize(pattern.blocks.size());
   for (size_t b = 0; b < pattern.blocks.size(); ++b)
     pattern.transposed[b] = index.at({pattern.blocks[b].col, pattern.blocks[b].row});
 }
+
+template void ModelT<double>::finalize();
+template void ModelT<HyperDual>::finalize();
 
 double characteristic_length(const Model& model) {
   double l = 0.0;

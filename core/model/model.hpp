@@ -187,6 +187,9 @@ struct ModelT {
   void finalize();
 };
 using Model = ModelT<double>;
+// A model whose numbers carry derivatives (core/model/hyper_dual.hpp).
+struct HyperDual;
+using DualModel = ModelT<HyperDual>;
 
 // The model with only the loads for which keep(load) is true, and with gravity or without. Bodies,
 // elements and the pattern are those of `model` (an analysis of one load case sees the same

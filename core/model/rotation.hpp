@@ -58,25 +58,28 @@ inline Vec4 quat_from_rotation_vector(const Vec3& theta) {
 }
 
 // Euler parameters of a proper rotation matrix (Shepperd's method), q0 >= 0.
-inline Vec4 quat_from_rotation_matrix(const Mat3& a) {
-  const double tr = a.trace();
-  Vec4 q;
+template <class T>
+Vec4T<T> quaternion_of(const Mat3T<T>& a) {
+  using std::sqrt;
+  const T tr = a.trace();
+  Vec4T<T> q;
   if (tr >= a(0, 0) && tr >= a(1, 1) && tr >= a(2, 2)) {
-    const double s = 2.0 * std::sqrt(1.0 + tr);
+    const T s = 2.0 * sqrt(1.0 + tr);
     q << 0.25 * s, (a(2, 1) - a(1, 2)) / s, (a(0, 2) - a(2, 0)) / s, (a(1, 0) - a(0, 1)) / s;
   } else if (a(0, 0) >= a(1, 1) && a(0, 0) >= a(2, 2)) {
-    const double s = 2.0 * std::sqrt(1.0 + 2.0 * a(0, 0) - tr);
+    const T s = 2.0 * sqrt(1.0 + 2.0 * a(0, 0) - tr);
     q << (a(2, 1) - a(1, 2)) / s, 0.25 * s, (a(0, 1) + a(1, 0)) / s, (a(0, 2) + a(2, 0)) / s;
   } else if (a(1, 1) >= a(2, 2)) {
-    const double s = 2.0 * std::sqrt(1.0 + 2.0 * a(1, 1) - tr);
+    const T s = 2.0 * sqrt(1.0 + 2.0 * a(1, 1) - tr);
     q << (a(0, 2) - a(2, 0)) / s, (a(0, 1) + a(1, 0)) / s, 0.25 * s, (a(1, 2) + a(2, 1)) / s;
   } else {
-    const double s = 2.0 * std::sqrt(1.0 + 2.0 * a(2, 2) - tr);
+    const T s = 2.0 * sqrt(1.0 + 2.0 * a(2, 2) - tr);
     q << (a(1, 0) - a(0, 1)) / s, (a(0, 2) + a(2, 0)) / s, (a(1, 2) + a(2, 1)) / s, 0.25 * s;
   }
-  if (q(0) < 0) q = -q;
+  if (q(0) < 0.0) q = -q;
   return q / q.norm();
 }
+inline Vec4 quat_from_rotation_matrix(const Mat3& a) { return quaternion_of<double>(a); }
 
 // The rotation vector of a proper rotation matrix (inverse of exp), angle in [0, pi].
 inline Vec3 rotation_vector(const Mat3& a) {

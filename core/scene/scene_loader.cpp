@@ -10,6 +10,7 @@
 #include <set>
 #include <string>
 
+#include "core/model/hyper_dual.hpp"
 #include "core/model/joint.hpp"
 #include "core/model/rotation.hpp"
 #include "core/scene/auto_segments.hpp"
@@ -18,9 +19,14 @@
 namespace beamrail {
 namespace {
 
+// Every function below runs on the model's scalar S: double, or HyperDual for the scene built
+// for the design sensitivities (whose values are those of the double scene, already validated).
+
 // Inertia of a point mass with rotary inertia `inertia_local` (element axes, about the point).
-PointMass lumped(double mass, const Vec3& point, const Mat3& frame, const Vec3& inertia_local) {
-  return {mass, point, frame * inertia_local.asDiagonal() * frame.transpose()};
+template <class S>
+PointMassT<S> lumped(const S& mass, const Vec3T<S>& point, const Mat3T<S>& frame,
+                     const Vec3T<S>& inertia_local) {
+  return {mass, point, Mat3T<S>(frame * inertia_local.asDiagonal() * frame.transpose())};
 }
 
 // Splits every segmented beam into `segments` sub-beams joined by generated interior bodies, and
@@ -28,35 +34,36 @@ PointMass lumped(double mass, const Vec3& point, const Mat3& frame, const Vec3& 
 // not split carries its mass lumped (docs/model.md "Mass"): a beam as one segment (half its mass
 // at each free end body), a rail wholly on body 1 (the rail's body; the carriage slides along it)
 // as a slender rod between its points. The dynamics then see the mass the mass response counts.
-void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>>& extra,
-                           std::vector<ElementSpec>& out) {
-  for (const ElementSpec& e : specs.elements) {
+template <class S>
+void split_segmented_beams(SceneSpecsT<S>& specs, std::vector<std::vector<PointMassT<S>>>& extra,
+                           std::vector<ElementSpecT<S>>& out) {
+  // By index: segments add bodies, not elements, but `out` may be specs.elements' successor.
+  for (const ElementSpecT<S>& e : specs.elements) {
     const long n = std::max(e.segments, 1L);
-    const Vec3 step = (e.p2 - e.p1) / static_cast<double>(n);
-    const double ls = step.norm();
-    const double rho = e.material.density;
-    const SectionProperties& s = e.section;
-    const double ms = rho * s.area * ls;
-    Diagnostics unused;  // the points were validated when read
-    const Mat3 frame = *element_frame(e.p1, e.p2, e.p3, e.where, unused);
+    const Vec3T<S> step = (e.p2 - e.p1) / static_cast<double>(n);
+    const S ls = step.norm();
+    const S rho = e.material.density;
+    const SectionPropertiesT<S>& s = e.section;
+    const S ms = rho * s.area * ls;
+    const Mat3T<S> frame = frame_of(e.p1, e.p2, e.p3);  // the points were validated when read
     // Rotary inertia of a slice of length a about its centre (element axes).
-    auto slice = [&](double a) {
-      const double m = rho * s.area * a;
-      return Vec3(rho * a * (s.iy + s.iz), rho * a * s.iy + m * a * a / 12.0,
-                  rho * a * s.iz + m * a * a / 12.0);
+    auto slice = [&](const S& a) {
+      const S m = rho * s.area * a;
+      return Vec3T<S>(rho * a * (s.iy + s.iz), rho * a * s.iy + m * a * a / 12.0,
+                      rho * a * s.iz + m * a * a / 12.0);
     };
     if (e.segments <= 0) {
       out.push_back(e);
       if (!(ms > 0.0)) continue;
       if (e.rail) {
         if (!specs.bodies[e.body1].fixed)
-          extra[e.body1].push_back(lumped(ms, 0.5 * (e.p1 + e.p2), frame, slice(ls)));
+          extra[e.body1].push_back(lumped(ms, Vec3T<S>(0.5 * (e.p1 + e.p2)), frame, slice(ls)));
         continue;
       }
     }
     // Half segment about the end node: its slice inertia plus m (a/2)^2 for the bending axes.
-    Vec3 half = slice(0.5 * ls);
-    const double mh = 0.5 * ms;
+    Vec3T<S> half = slice(0.5 * ls);
+    const S mh = 0.5 * ms;
     half(1) += mh * 0.0625 * ls * ls;
     half(2) += mh * 0.0625 * ls * ls;
     if (!specs.bodies[e.body1].fixed) extra[e.body1].push_back(lumped(mh, e.p1, frame, half));
@@ -65,34 +72,33 @@ void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>
 
     // Interior bodies share the element's orientation; their velocities blend the ends'.
     // Copies: adding the interior bodies below may reallocate specs.bodies.
-    const BodySpec b1 = specs.bodies[e.body1];
-    const BodySpec b2 = specs.bodies[e.body2];
-    const Mat3 a1 = rotation_matrix<double>(b1.orientation),
-               a2 = rotation_matrix<double>(b2.orientation);
-    const Vec3 om1 = a1 * b1.angular_velocity, om2 = a2 * b2.angular_velocity;
+    const BodySpecT<S> b1 = specs.bodies[e.body1];
+    const BodySpecT<S> b2 = specs.bodies[e.body2];
+    const Mat3T<S> a1 = rotation_matrix<S>(b1.orientation), a2 = rotation_matrix<S>(b2.orientation);
+    const Vec3T<S> om1 = a1 * b1.angular_velocity, om2 = a2 * b2.angular_velocity;
     int previous = e.body1;
     for (long k = 1; k <= n; ++k) {
       int next = e.body2;
       if (k < n) {
         const double s_k = static_cast<double>(k) / static_cast<double>(n);
-        BodySpec node;
+        BodySpecT<S> node;
         node.name = e.name + ".node" + std::to_string(k);
         node.where = e.where;
         node.generated = true;
         node.position = e.p1 + static_cast<double>(k) * step;
-        node.orientation = quat_from_rotation_matrix(frame);
-        const Vec3 v1 = b1.velocity + om1.cross(node.position - b1.position);
-        const Vec3 v2 = b2.velocity + om2.cross(node.position - b2.position);
+        node.orientation = quaternion_of<S>(frame);
+        const Vec3T<S> v1 = b1.velocity + om1.cross(node.position - b1.position);
+        const Vec3T<S> v2 = b2.velocity + om2.cross(node.position - b2.position);
         node.velocity = (1.0 - s_k) * v1 + s_k * v2;
         node.angular_velocity = frame.transpose() * ((1.0 - s_k) * om1 + s_k * om2);
         node.mass = ms;
-        const Vec3 j = slice(ls);
-        node.inertia = Mat3(j.asDiagonal());
+        const Vec3T<S> j = slice(ls);
+        node.inertia = Mat3T<S>(j.asDiagonal());
         next = static_cast<int>(specs.bodies.size());
         specs.bodies.push_back(node);
         extra.emplace_back();
       }
-      ElementSpec sub = e;
+      ElementSpecT<S> sub = e;
       sub.name = e.name + ".seg" + std::to_string(k);
       sub.segments = -k;  // marks "segment k of e.name"
       sub.body1 = previous, sub.body2 = next;
@@ -107,20 +113,22 @@ void split_segmented_beams(SceneSpecs& specs, std::vector<std::vector<PointMass>
 
 // Combines a body's own mass with the lumped masses of segments into one rigid body; returns the
 // combined centre of mass and sets mass and inertia (body axes).
-Vec3 combine_masses(const BodySpec& b, const std::vector<PointMass>& extra, double* mass,
-                    Mat3* inertia) {
-  const Mat3 a = rotation_matrix<double>(b.orientation);
-  std::vector<PointMass> parts = extra;
+template <class S>
+Vec3T<S> combine_masses(const BodySpecT<S>& b, const std::vector<PointMassT<S>>& extra, S* mass,
+                        Mat3T<S>* inertia) {
+  const Mat3T<S> a = rotation_matrix<S>(b.orientation);
+  std::vector<PointMassT<S>> parts = extra;
   if (b.mass)
-    parts.push_back({*b.mass, b.position, a * b.inertia.value_or(Mat3::Zero()) * a.transpose()});
-  double m = 0.0;
-  Vec3 first = Vec3::Zero();
-  for (const PointMass& p : parts) m += p.mass, first += p.mass * p.point;
-  const Vec3 c = m > 0.0 ? Vec3(first / m) : b.position;
-  Mat3 j = Mat3::Zero();
-  for (const PointMass& p : parts) {
-    const Vec3 d = p.point - c;
-    j += p.inertia + p.mass * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+    parts.push_back(
+        {*b.mass, b.position, Mat3T<S>(a * b.inertia.value_or(Mat3T<S>::Zero()) * a.transpose())});
+  S m = 0.0;
+  Vec3T<S> first = Vec3T<S>::Zero();
+  for (const PointMassT<S>& p : parts) m += p.mass, first += p.mass * p.point;
+  const Vec3T<S> c = m > 0.0 ? Vec3T<S>(first / m) : b.position;
+  Mat3T<S> j = Mat3T<S>::Zero();
+  for (const PointMassT<S>& p : parts) {
+    const Vec3T<S> d = p.point - c;
+    j += p.inertia + p.mass * (d.squaredNorm() * Mat3T<S>::Identity() - d * d.transpose());
   }
   *mass = m;
   *inertia = a.transpose() * j * a;
@@ -152,16 +160,15 @@ std::string out_of_range(const ElementSpec& e, const ElementEnds& ends) {
   return "";
 }
 
-ElementEnds make_ends(const ElementSpec& e, const std::vector<Body>& bodies) {
-  ElementEnds ends;
+template <class S>
+ElementEndsT<S> make_ends(const ElementSpecT<S>& e, const std::vector<BodyT<S>>& bodies) {
+  ElementEndsT<S> ends;
   ends.body1 = e.body1;
   ends.body2 = e.body2;
-  Diagnostics unused;  // the points were validated when read
-  const Mat3 frame = *element_frame(e.p1, e.p2, e.p3, e.where, unused);
-  const Body& b1 = bodies[e.body1];
-  const Body& b2 = bodies[e.body2];
-  const Mat3 a1 = rotation_matrix<double>(b1.orientation),
-             a2 = rotation_matrix<double>(b2.orientation);
+  const Mat3T<S> frame = frame_of(e.p1, e.p2, e.p3);  // the points were validated when read
+  const BodyT<S>& b1 = bodies[e.body1];
+  const BodyT<S>& b2 = bodies[e.body2];
+  const Mat3T<S> a1 = rotation_matrix<S>(b1.orientation), a2 = rotation_matrix<S>(b2.orientation);
   ends.r1 = a1.transpose() * (e.p1 - b1.position);
   ends.r2 = a2.transpose() * (e.p2 - b2.position);
   ends.frame1 = a1.transpose() * frame;
@@ -188,11 +195,13 @@ SegmentationTarget read_segmentation(const Json& value, const Where& where, Diag
 
 // Sets the segment count of every beam with "segments": "auto" (pinned: the counts of the study's
 // scene, kept by the designs built from it) and records the choices.
-void choose_auto_segments(SceneSpecs& specs, const SegmentationTarget& target,
+// A HyperDual scene takes every count from `pinned` (an unpinned beam is an error there).
+template <class S>
+void choose_auto_segments(SceneSpecsT<S>& specs, const SegmentationTarget& target,
                           const std::vector<SegmentChoice>* pinned, Diagnostics& diag,
                           std::vector<SegmentChoice>& choices) {
   std::map<std::array<double, 6>, SegmentChoice> by_beam;  // identical members choose once
-  for (ElementSpec& e : specs.elements) {
+  for (ElementSpecT<S>& e : specs.elements) {
     if (!e.auto_segments) continue;
     SegmentChoice c;
     const auto kept = pinned
@@ -202,6 +211,10 @@ void choose_auto_segments(SceneSpecs& specs, const SegmentationTarget& target,
     if (pinned && kept != pinned->end()) {
       c = *kept;
       c.pinned = true;
+    } else if constexpr (!std::is_same_v<S, double>) {
+      diag.error(e.where.file, (e.where / "segments").pointer,
+                 "no count of the study's scene for this beam's \"auto\" segments");
+      return;
     } else {
       const double rho = e.material.density;
       UniformBeam b;
@@ -239,26 +252,30 @@ void choose_auto_segments(SceneSpecs& specs, const SegmentationTarget& target,
 // The joints of the scene, with their penalty stiffness (core/model/joint.hpp) from the model's
 // elements and loads; reports a joint point far from both its bodies: beyond 3 radii of gyration
 // and beyond every element attachment point of each body (a fixed body reaches everywhere).
-void build_joints(const SceneSpecs& specs, const std::vector<ElementSpec>& elements, Model& model,
-                  Diagnostics& diag) {
+template <class S>
+void build_joints(const SceneSpecsT<S>& specs, const std::vector<ElementSpecT<S>>& elements,
+                  ModelT<S>& model, Diagnostics& diag) {
   std::vector<double> reach(model.bodies.size(), 0.0);
   for (size_t i = 0; i < model.bodies.size(); ++i) {
-    const Body& b = model.bodies[i];
+    const BodyT<S>& b = model.bodies[i];
     if (b.fixed) {
       reach[i] = std::numeric_limits<double>::infinity();
     } else {
-      const Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia);
-      reach[i] = 3.0 * std::sqrt(eig.eigenvalues().maxCoeff() / b.mass);
+      const Eigen::SelfAdjointEigenSolver<Mat3> eig(values_of(b.inertia));
+      reach[i] = 3.0 * std::sqrt(eig.eigenvalues().maxCoeff() / value_of(b.mass));
     }
   }
-  for (const ElementSpec& e : elements) {
-    reach[e.body1] = std::max(reach[e.body1], (e.p1 - model.bodies[e.body1].position).norm());
-    reach[e.body2] = std::max(reach[e.body2], (e.p2 - model.bodies[e.body2].position).norm());
+  const auto distance = [](const Vec3T<S>& a, const Vec3T<S>& b) {
+    return (values_of(a) - values_of(b)).norm();
+  };
+  for (const ElementSpecT<S>& e : elements) {
+    reach[e.body1] = std::max(reach[e.body1], distance(e.p1, model.bodies[e.body1].position));
+    reach[e.body2] = std::max(reach[e.body2], distance(e.p2, model.bodies[e.body2].position));
   }
-  for (const JointSpec& s : specs.joints) {
-    const Body& b1 = model.bodies[s.body1];
-    const Body& b2 = model.bodies[s.body2];
-    const double d1 = (s.point - b1.position).norm(), d2 = (s.point - b2.position).norm();
+  for (const JointSpecT<S>& s : specs.joints) {
+    const BodyT<S>& b1 = model.bodies[s.body1];
+    const BodyT<S>& b2 = model.bodies[s.body2];
+    const double d1 = distance(s.point, b1.position), d2 = distance(s.point, b2.position);
     if (!(d1 <= reach[s.body1]) && !(d2 <= reach[s.body2])) {
       char text[240];
       std::snprintf(text, sizeof text,
@@ -270,18 +287,24 @@ void build_joints(const SceneSpecs& specs, const std::vector<ElementSpec>& eleme
       diag.error(s.where.file, (s.where / "point").pointer, text);
       continue;
     }
-    Joint j;
+    JointT<S> j;
     j.name = s.name;
     j.type = s.type;
     j.body1 = s.body1, j.body2 = s.body2;
-    const Mat3 a1 = rotation_matrix<double>(b1.orientation);
-    const Mat3 a2 = rotation_matrix<double>(b2.orientation);
+    const Mat3T<S> a1 = rotation_matrix<S>(b1.orientation);
+    const Mat3T<S> a2 = rotation_matrix<S>(b2.orientation);
     j.r1 = a1.transpose() * (s.point - b1.position);
     j.r2 = a2.transpose() * (s.point - b2.position);
-    // The joint frame in global axes: the axis and two directions perpendicular to it.
-    Mat3 frame;
+    // The joint frame in global axes: the axis and two directions perpendicular to it (on other
+    // scalars, the double frame's second direction kept perpendicular as the axis turns).
+    Mat3T<S> frame;
     frame.col(0) = s.axis;
-    frame.col(1) = s.axis.unitOrthogonal();
+    if constexpr (std::is_same_v<S, double>) {
+      frame.col(1) = s.axis.unitOrthogonal();
+    } else {
+      const Vec3T<S> e = Vec3(values_of(s.axis).unitOrthogonal()).cast<S>();
+      frame.col(1) = (e - e.dot(s.axis) * s.axis).normalized();
+    }
     frame.col(2) = s.axis.cross(frame.col(1));
     j.frame1 = a1.transpose() * frame;
     j.frame2 = a2.transpose() * frame;
@@ -290,24 +313,28 @@ void build_joints(const SceneSpecs& specs, const std::vector<ElementSpec>& eleme
     model.joints.push_back(j);
   }
   const auto [kt, kr] = joint_stiffness_scale(model);
-  for (Joint& j : model.joints) {
+  for (JointT<S>& j : model.joints) {
     j.k_force = kt / j.relative_compliance;
     j.k_moment = kr / j.relative_compliance;
   }
 }
 
-}  // namespace
-
-std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnostics& diag,
-                                const std::vector<SegmentChoice>* pinned) {
+// The scene on scalar S (load_scene, load_dual_scene); a HyperDual scene checks only what its
+// reading checks (its values are those of the double scene, built and checked before).
+template <class S>
+std::optional<ModelT<S>> build_scene(const Json& scene, const Where& where, Diagnostics& diag,
+                                     const std::vector<SegmentChoice>* pinned,
+                                     const std::map<std::string, double>& seeds) {
+  constexpr bool checked = std::is_same_v<S, double>;
   const size_t errors_before = diag.size();
-  SceneSpecs specs;
+  SceneSpecsT<S> specs;
+  specs.seeds = seeds;
   SegmentationTarget target;
   bool target_given = false;
   {
     ObjectReader r(scene, where, diag);
     if (!r.is_object()) return std::nullopt;
-    specs.gravity = r.vec3("gravity", false).value_or(Vec3::Zero());
+    specs.gravity = seeded(specs, r.vec3("gravity", false).value_or(Vec3::Zero()), r.at("gravity"));
     if (const Json* seg = r.member("segmentation", false)) {
       target = read_segmentation(*seg, r.at("segmentation"), diag);
       target_given = true;
@@ -321,23 +348,31 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     read_joints(r, specs);
   }
   if (diag.size() > errors_before) return std::nullopt;
+  for (const auto& [pointer, derivative] : specs.seeds)
+    if (!specs.seeds_read.count(pointer))
+      diag.error(where.file, pointer,
+                 "not a number the scene's build differentiates (a count, a flag, a time "
+                 "function's parameter, or no number of the scene)");
+  if (diag.size() > errors_before) return std::nullopt;
   std::vector<SegmentChoice> choices;
   choose_auto_segments(specs, target, pinned, diag, choices);
   if (diag.size() > errors_before) return std::nullopt;
-  if (target_given && choices.empty())
-    diag.warning(where.file, (where / "segmentation").pointer,
-                 "no beam has \"segments\": \"auto\": the segmentation target does nothing");
-  check_plausibility(specs, where, diag);
+  if constexpr (checked) {
+    if (target_given && choices.empty())
+      diag.warning(where.file, (where / "segmentation").pointer,
+                   "no beam has \"segments\": \"auto\": the segmentation target does nothing");
+    check_plausibility(specs, where, diag);
+  }
 
-  std::vector<std::vector<PointMass>> extra(specs.bodies.size());
-  std::vector<ElementSpec> elements;
+  std::vector<std::vector<PointMassT<S>>> extra(specs.bodies.size());
+  std::vector<ElementSpecT<S>> elements;
   split_segmented_beams(specs, extra, elements);
 
-  Model model;
+  ModelT<S> model;
   model.gravity = specs.gravity;
   // One report per scene entry: the interior bodies of a segmented beam share their beam's.
   std::set<std::string> reported;
-  auto body_error = [&](const BodySpec& s, const std::string& what) {
+  auto body_error = [&](const BodySpecT<S>& s, const std::string& what) {
     if (!reported.insert(s.where.pointer).second) return;
     const std::string who = s.generated
                                 ? "beam \"" + s.name.substr(0, s.name.rfind(".node")) + "\": "
@@ -345,44 +380,49 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     diag.error(s.where.file, s.where.pointer, who + what);
   };
   for (size_t i = 0; i < specs.bodies.size(); ++i) {
-    const BodySpec& s = specs.bodies[i];
-    Body b;
+    const BodySpecT<S>& s = specs.bodies[i];
+    BodyT<S> b;
     b.name = s.name;
     b.fixed = s.fixed;
     b.generated = s.generated;
-    b.declared_mass = b.generated ? 0.0 : s.mass.value_or(0.0);
+    b.declared_mass = b.generated ? S(0.0) : s.mass.value_or(S(0.0));
     b.orientation = s.orientation;
     b.velocity = s.velocity;
     b.angular_velocity = s.angular_velocity;
     b.position = combine_masses(s, extra[i], &b.mass, &b.inertia);
-    // Values each finite can still combine into an overflow (a density of 1e308, a centre 1e308
-    // away): reported here rather than met as NaN in an analysis.
-    if (!std::isfinite(b.mass) || !b.inertia.allFinite() || !b.position.allFinite() ||
-        !b.velocity.allFinite() || !b.angular_velocity.allFinite()) {
-      body_error(s, "the " + out_of_range(b) + (s.generated ? " of its interior bodies" : "") +
-                        " is out of the range of double precision (not finite)");
-      continue;
-    }
-    if (!b.fixed) {
-      const Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia);
-      if (!(b.mass > 0.0) || !(eig.eigenvalues().minCoeff() > 0.0)) {
-        if (s.generated)
-          body_error(s,
-                     "the mass or inertia of its interior bodies is zero in double precision "
-                     "(density or section too small)");
-        else
-          diag.error(s.where.file, s.where.pointer,
-                     "free body \"" + s.name +
-                         "\" has no mass: give \"mass\" and \"inertia\", attach a segmented "
-                         "beam, or set \"fixed\": true");
+    if constexpr (!checked) {
+      if (!b.fixed) b.inertia_inverse = b.inertia.inverse();
+    } else {
+      // Values each finite can still combine into an overflow (a density of 1e308, a centre 1e308
+      // away): reported here rather than met as NaN in an analysis.
+      if (!std::isfinite(b.mass) || !b.inertia.allFinite() || !b.position.allFinite() ||
+          !b.velocity.allFinite() || !b.angular_velocity.allFinite()) {
+        body_error(s, "the " + out_of_range(b) + (s.generated ? " of its interior bodies" : "") +
+                          " is out of the range of double precision (not finite)");
         continue;
       }
-      b.inertia_inverse = b.inertia.inverse();
-      if (!b.inertia_inverse.allFinite()) {
-        body_error(s, std::string("the inertia") + (s.generated ? " of its interior bodies" : "") +
-                          " cannot be inverted in double precision (values too large or too "
-                          "small)");
-        continue;
+      if (!b.fixed) {
+        const Eigen::SelfAdjointEigenSolver<Mat3> eig(b.inertia);
+        if (!(b.mass > 0.0) || !(eig.eigenvalues().minCoeff() > 0.0)) {
+          if (s.generated)
+            body_error(s,
+                       "the mass or inertia of its interior bodies is zero in double precision "
+                       "(density or section too small)");
+          else
+            diag.error(s.where.file, s.where.pointer,
+                       "free body \"" + s.name +
+                           "\" has no mass: give \"mass\" and \"inertia\", attach a segmented "
+                           "beam, or set \"fixed\": true");
+          continue;
+        }
+        b.inertia_inverse = b.inertia.inverse();
+        if (!b.inertia_inverse.allFinite()) {
+          body_error(s, std::string("the inertia") +
+                            (s.generated ? " of its interior bodies" : "") +
+                            " cannot be inverted in double precision (values too large or too "
+                            "small)");
+          continue;
+        }
       }
     }
     model.bodies.push_back(b);
@@ -390,9 +430,11 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
   if (diag.size() > errors_before) return std::nullopt;
 
   reported.clear();  // now one report per scene element, not per segment
-  for (const ElementSpec& e : elements) {
-    const ElementEnds ends = make_ends(e, model.bodies);
-    if (const std::string what = out_of_range(e, ends); !what.empty()) {
+  for (const ElementSpecT<S>& e : elements) {
+    const ElementEndsT<S> ends = make_ends(e, model.bodies);
+    std::string what;
+    if constexpr (checked) what = out_of_range(e, ends);
+    if (!what.empty()) {
       const std::string name = e.segments < 0 ? e.name.substr(0, e.name.rfind(".seg")) : e.name;
       if (reported.insert(e.where.pointer).second)
         diag.error(e.where.file, e.where.pointer,
@@ -400,9 +442,9 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
                        " is out of the range of double precision (not finite)");
       continue;
     }
-    const double modulus_e = e.material.e, modulus_g = e.material.g;
+    const S modulus_e = e.material.e, modulus_g = e.material.g;
     if (!e.rail) {
-      Beam b;
+      BeamT<S> b;
       b.name = e.name;
       b.group = e.segments < 0 ? e.name.substr(0, e.name.rfind(".seg")) : e.name;
       b.segment = e.segments < 0 ? static_cast<int>(-e.segments) : 0;
@@ -417,14 +459,15 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
       b.density = e.material.density;
       model.beams.push_back(b);
     } else {
-      Rail r;
+      RailT<S> r;
       r.name = e.name;
       r.type = e.rail_type;
       r.ends = ends;
-      r.gj = e.rail_type == RailType::kPrismatic ? modulus_g * e.section.torsion_constant : 0.0;
+      r.gj =
+          e.rail_type == RailType::kPrismatic ? S(modulus_g * e.section.torsion_constant) : S(0.0);
       r.eiy = modulus_e * e.section.iy;
       r.eiz = modulus_e * e.section.iz;
-      r.min_length = e.min_length.value_or(1e-3 * ends.length);
+      r.min_length = e.min_length.value_or(S(1e-3 * ends.length));
       if (e.travel) r.travel_min = (*e.travel)[0], r.travel_max = (*e.travel)[1];
       r.damping = e.damping;
       r.formulation = e.formulation;
@@ -437,12 +480,12 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
   if (diag.size() > errors_before) return std::nullopt;
 
   for (size_t k = 0; k < specs.loads.size(); ++k) {
-    Load load = specs.loads[k];
-    const Body& b = model.bodies[load.body];
+    LoadT<S> load = specs.loads[k];
+    const BodyT<S>& b = model.bodies[load.body];
     load.offset =
-        rotation_matrix<double>(b.orientation).transpose() * (specs.load_points[k] - b.position);
+        rotation_matrix<S>(b.orientation).transpose() * (specs.load_points[k] - b.position);
     // Every load was accepted, so k is its index in the scene.
-    if (!load.offset.allFinite()) {
+    if (!values_of(load.offset).allFinite()) {
       diag.error(where.file, (where / "loads" / k / "point").pointer,
                  "the distance from the body's centre of mass is out of the range of double "
                  "precision (not finite)");
@@ -465,6 +508,20 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
     return std::nullopt;
   }
   return model;
+}
+
+}  // namespace
+
+std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnostics& diag,
+                                const std::vector<SegmentChoice>* pinned) {
+  return build_scene<double>(scene, where, diag, pinned, {});
+}
+
+std::optional<DualModel> load_dual_scene(const Json& scene, const Where& where,
+                                         const std::map<std::string, double>& seeds,
+                                         const std::vector<SegmentChoice>& pinned,
+                                         Diagnostics& diag) {
+  return build_scene<HyperDual>(scene, where, diag, &pinned, seeds);
 }
 
 }  // namespace beamrail

@@ -3,7 +3,9 @@
 // returned only when there are none.
 #pragma once
 
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/model/model.hpp"
@@ -17,5 +19,19 @@ namespace beamrail {
 // chosen for the scene's "segmentation" target (core/scene/auto_segments.hpp).
 std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnostics& diag,
                                 const std::vector<SegmentChoice>* pinned = nullptr);
+
+// The Model of the same scene on hyper-dual numbers (core/model/hyper_dual.hpp): forward-mode
+// automatic differentiation through the whole build (sections from their dimensions, segment
+// masses and inertias, centres of mass, attachment points and frames, joint stiffness). The
+// numbers at the JSON pointers of `seeds` (canonical, as Where writes them) carry the derivative
+// given there in their e2 part, and so every number of the model carries its derivative with
+// respect to the design parameter. For a scene that load_scene built without errors, with its
+// "auto" segment counts in `pinned`; reports problems as load_scene does but checks only what its
+// reading checks, and reports a seed that addresses no number the build differentiates (a segment
+// count, a time function's parameter: nullopt, never a derivative silently 0).
+std::optional<DualModel> load_dual_scene(const Json& scene, const Where& where,
+                                         const std::map<std::string, double>& seeds,
+                                         const std::vector<SegmentChoice>& pinned,
+                                         Diagnostics& diag);
 
 }  // namespace beamrail

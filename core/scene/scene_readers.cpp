@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/model/hyper_dual.hpp"
 #include "core/model/rotation.hpp"
 #include "core/model/section.hpp"
 #include "core/scene/scene_specs.hpp"
@@ -41,7 +42,11 @@ void for_each_entry(ObjectReader& parent, const std::string& key, F&& f) {
   for (size_t i = 0; i < arr->size(); ++i) f((*arr)[i], parent.at(key) / i);
 }
 
-std::optional<SectionProperties> read_section(ObjectReader& r) {
+template <class S>
+std::optional<SectionPropertiesT<S>> read_section(ObjectReader& r, const SceneSpecsT<S>& specs) {
+  const auto number = [&](const std::string& key, bool required) {
+    return seeded(specs, r.positive(key, required), r.at(key));
+  };
   const auto shape = r.choice("shape", true, {"rectangle", "circle", "tube", "box", "custom"});
   if (!shape) {
     r.allow({"width", "height", "diameter", "outer_diameter", "wall", "S", "Ix", "Iy", "Iz", "Wy",
@@ -49,31 +54,32 @@ std::optional<SectionProperties> read_section(ObjectReader& r) {
     return std::nullopt;
   }
   if (*shape == "rectangle") {
-    const auto w = r.positive("width", true), h = r.positive("height", true);
+    const auto w = number("width", true), h = number("height", true);
     if (w && h) return rectangle_section(*w, *h);
   } else if (*shape == "circle") {
-    if (const auto d = r.positive("diameter", true)) return circle_section(*d);
+    if (const auto d = number("diameter", true)) return circle_section(*d);
   } else if (*shape == "tube") {
-    const auto d = r.positive("outer_diameter", true), t = r.positive("wall", true);
+    const auto d = number("outer_diameter", true), t = number("wall", true);
     if (d && t) {
       if (*t < 0.5 * *d) return tube_section(*d, *t);
-      r.error("wall", "must be less than half the outer diameter (" + number_text(*d / 2) + ")");
+      r.error("wall",
+              "must be less than half the outer diameter (" + number_text(value_of(*d) / 2) + ")");
     }
   } else if (*shape == "box") {
-    const auto w = r.positive("width", true), h = r.positive("height", true);
-    const auto t = r.positive("wall", true);
+    const auto w = number("width", true), h = number("height", true);
+    const auto t = number("wall", true);
     if (w && h && t) {
-      if (*t < 0.5 * std::min(*w, *h)) return box_section(*w, *h, *t);
+      if (*t < 0.5 * std::min(value_of(*w), value_of(*h))) return box_section(*w, *h, *t);
       r.error("wall", "must be less than half the smaller of width and height");
     }
   } else {
-    SectionProperties s;
-    const auto area = r.positive("S", true), ix = r.positive("Ix", true);
-    const auto iy = r.positive("Iy", true), iz = r.positive("Iz", true);
-    const auto wy = r.positive("Wy", false), wz = r.positive("Wz", false);
+    SectionPropertiesT<S> s;
+    const auto area = number("S", true), ix = number("Ix", true);
+    const auto iy = number("Iy", true), iz = number("Iz", true);
+    const auto wy = number("Wy", false), wz = number("Wz", false);
     if (area && ix && iy && iz) {
       s.area = *area, s.torsion_constant = *ix, s.iy = *iy, s.iz = *iz;
-      s.wy = wy.value_or(0.0), s.wz = wz.value_or(0.0);
+      s.wy = wy.value_or(S(0.0)), s.wz = wz.value_or(S(0.0));
       return s;
     }
   }
@@ -118,6 +124,21 @@ std::optional<Mat3> read_inertia(ObjectReader& r) {
     return std::nullopt;
   }
   return j;
+}
+
+// The inertia read by read_inertia with the numbers at `at` / 0 .. 5 seeded ([xx, yy, zz] or
+// [xx, yy, zz, xy, xz, yz]).
+template <class S>
+Mat3T<S> seeded_inertia(const SceneSpecsT<S>& specs, const Mat3& j, const Where& at, bool tensor) {
+  Mat3T<S> out = j.cast<S>();
+  for (size_t i = 0; i < 3; ++i) out(i, i) = seeded(specs, j(i, i), at / i);
+  if (tensor) {
+    const int rows[3] = {0, 0, 1}, cols[3] = {1, 2, 2};
+    for (size_t k = 0; k < 3; ++k)
+      out(rows[k], cols[k]) = out(cols[k], rows[k]) =
+          seeded(specs, j(rows[k], cols[k]), at / (3 + k));
+  }
+  return out;
 }
 
 std::optional<TimeFunction> read_time_function(const Json& value, const Where& where,
@@ -172,7 +193,8 @@ std::optional<TimeFunction> read_time_function(const Json& value, const Where& w
 }
 
 // Resolves a body name ("ground" or a scene body).
-std::optional<int> body_ref(ObjectReader& r, const std::string& key, const SceneSpecs& specs) {
+template <class S>
+std::optional<int> body_ref(ObjectReader& r, const std::string& key, const SceneSpecsT<S>& specs) {
   const auto name = r.string(key, true);
   if (!name) return std::nullopt;
   const auto it = specs.body_index.find(*name);
@@ -185,7 +207,8 @@ std::optional<int> body_ref(ObjectReader& r, const std::string& key, const Scene
 
 // Takes `name` for an element (beams, rails and joints share one name space); false, reported
 // at "name", when it is empty or taken.
-bool claim_element_name(ObjectReader& r, const std::string& name, SceneSpecs& specs) {
+template <class S>
+bool claim_element_name(ObjectReader& r, const std::string& name, SceneSpecsT<S>& specs) {
   if (name.empty()) {
     r.error("name", "must not be empty");
     return false;
@@ -206,7 +229,8 @@ bool unusable(ObjectReader& scene, const std::string& key, bool array) {
 
 }  // namespace
 
-void read_materials(ObjectReader& scene, SceneSpecs& specs) {
+template <class S>
+void read_materials(ObjectReader& scene, SceneSpecsT<S>& specs) {
   specs.materials_incomplete = unusable(scene, "materials", false);
   for_each_member(scene, "materials", [&](const std::string& name, const Json& v, const Where& at) {
     ObjectReader r(v, at, scene.diagnostics());
@@ -214,28 +238,31 @@ void read_materials(ObjectReader& scene, SceneSpecs& specs) {
     const auto rho = r.positive("density", false, true);
     const bool density_ok = rho || !r.member("density", false);
     if (e && g && density_ok)
-      specs.materials[name] = {*e, *g, rho.value_or(0.0)};
+      specs.materials[name] = {seeded(specs, *e, r.at("E")), seeded(specs, *g, r.at("G")),
+                               seeded(specs, rho.value_or(0.0), r.at("density"))};
     else
       specs.invalid_materials.insert(name);
   });
 }
 
-void read_sections(ObjectReader& scene, SceneSpecs& specs) {
+template <class S>
+void read_sections(ObjectReader& scene, SceneSpecsT<S>& specs) {
   specs.sections_incomplete = unusable(scene, "sections", false);
   for_each_member(scene, "sections", [&](const std::string& name, const Json& v, const Where& at) {
     ObjectReader r(v, at, scene.diagnostics());
-    std::optional<SectionProperties> s;
-    if (r.is_object()) s = read_section(r);
+    std::optional<SectionPropertiesT<S>> s;
+    if (r.is_object()) s = read_section(r, specs);
     // Dimensions each finite can give properties that are not (a width of 1e200: S = inf, or
     // 1e-200: S = 0).
-    const auto in_range = [](double x) { return std::isfinite(x) && x > 0.0; };
+    const auto in_range = [](const S& x) { return std::isfinite(value_of(x)) && x > 0.0; };
     if (s && !(in_range(s->area) && in_range(s->torsion_constant) && in_range(s->iy) &&
                in_range(s->iz))) {
       scene.diagnostics().error(
           at.file, at.pointer,
           "the section's properties are out of the range of double precision (S = " +
-              number_text(s->area) + ", Ix = " + number_text(s->torsion_constant) +
-              ", Iy = " + number_text(s->iy) + ", Iz = " + number_text(s->iz) + ")");
+              number_text(value_of(s->area)) +
+              ", Ix = " + number_text(value_of(s->torsion_constant)) + ", Iy = " +
+              number_text(value_of(s->iy)) + ", Iz = " + number_text(value_of(s->iz)) + ")");
       s.reset();
     }
     if (s)
@@ -245,8 +272,9 @@ void read_sections(ObjectReader& scene, SceneSpecs& specs) {
   });
 }
 
-void read_bodies(ObjectReader& scene, SceneSpecs& specs) {
-  BodySpec ground;
+template <class S>
+void read_bodies(ObjectReader& scene, SceneSpecsT<S>& specs) {
+  BodySpecT<S> ground;
   ground.name = "ground";
   ground.fixed = true;
   specs.bodies.push_back(ground);
@@ -259,24 +287,31 @@ void read_bodies(ObjectReader& scene, SceneSpecs& specs) {
       specs.bodies_incomplete = true;
       return;
     }
-    BodySpec b;
+    BodySpecT<S> b;
     b.where = at;
     const auto name = r.string("name", true);
     b.fixed = r.boolean("fixed", false).value_or(false);
-    b.mass = r.positive("mass", false);
-    b.inertia = read_inertia(r);
+    b.mass = seeded(specs, r.positive("mass", false), r.at("mass"));
+    if (const auto j = read_inertia(r)) {
+      const Json* given = r.member("inertia", false);
+      b.inertia = seeded_inertia(specs, *j, r.at("inertia"), given && given->size() == 6);
+    }
     const auto position = r.vec3("position", true);
     const auto orientation = r.numbers("orientation", false, 4);
-    b.velocity = r.vec3("velocity", false).value_or(Vec3::Zero());
-    b.angular_velocity = r.vec3("angular_velocity", false).value_or(Vec3::Zero());
-    if (position) b.position = *position;
+    b.velocity = seeded(specs, r.vec3("velocity", false).value_or(Vec3::Zero()), r.at("velocity"));
+    b.angular_velocity = seeded(specs, r.vec3("angular_velocity", false).value_or(Vec3::Zero()),
+                                r.at("angular_velocity"));
+    if (position) b.position = seeded(specs, *position, r.at("position"));
     if (orientation) {
       const Vec4 q((*orientation)[0], (*orientation)[1], (*orientation)[2], (*orientation)[3]);
-      if (std::abs(q.norm() - 1.0) > 1e-3)
+      if (std::abs(q.norm() - 1.0) > 1e-3) {
         r.error("orientation",
                 "Euler parameters must have unit norm (norm is " + number_text(q.norm()) + ")");
-      else
-        b.orientation = q / q.norm();
+      } else {
+        Vec4T<S> qs;
+        for (size_t i = 0; i < 4; ++i) qs(i) = seeded(specs, q(i), r.at("orientation") / i);
+        b.orientation = qs / qs.norm();
+      }
     }
     // Only when the other one is absent (an invalid one was reported already).
     const bool has_mass = r.member("mass", false), has_inertia = r.member("inertia", false);
@@ -335,12 +370,13 @@ std::optional<Mat3> element_frame(const Vec3& p1, const Vec3& p2, const Vec3& p3
   return frame;
 }
 
-void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
+template <class S>
+void read_elements(ObjectReader& scene, SceneSpecsT<S>& specs, bool rails) {
   Diagnostics& diag = scene.diagnostics();
   for_each_entry(scene, rails ? "rails" : "beams", [&](const Json& v, const Where& at) {
     ObjectReader r(v, at, diag);
     if (!r.is_object()) return;
-    ElementSpec e;
+    ElementSpecT<S> e;
     e.where = at;
     e.rail = rails;
     const auto name = r.string("name", true);
@@ -352,7 +388,7 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
     const auto p1 = r.vec3("point1", true), p2 = r.vec3("point2", true);
     const auto p3 = r.vec3("point3", true);
     const auto material = r.string("material", true), section = r.string("section", true);
-    e.damping = r.positive("damping", false, true).value_or(0.0);
+    e.damping = seeded(specs, r.positive("damping", false, true).value_or(0.0), r.at("damping"));
     const auto form = r.choice("formulation", false, {"energy", "paper"});
     if (form && *form == "paper") e.formulation = Formulation::kPaper;
     std::optional<long> segments;
@@ -381,21 +417,24 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
       e.segments = segments.value_or(0);
     }
     if (rails) {
-      e.min_length = r.positive("min_length", false);
-      e.travel = r.numbers("travel", false, 2);
-      if (e.travel && !((*e.travel)[0] < (*e.travel)[1])) {
+      e.min_length = seeded(specs, r.positive("min_length", false), r.at("min_length"));
+      auto travel = r.numbers("travel", false, 2);
+      if (travel && !((*travel)[0] < (*travel)[1])) {
         r.error("travel", "must be [min, max] with min < max (metres along the rail from point 1)");
-        e.travel.reset();
-      } else if (e.travel && p1 && p2) {
+        travel.reset();
+      } else if (travel && p1 && p2) {
         const double l0 = (*p2 - *p1).norm();
-        if (!(l0 >= (*e.travel)[0] && l0 <= (*e.travel)[1])) {
+        if (!(l0 >= (*travel)[0] && l0 <= (*travel)[1])) {
           char text[160];
           std::snprintf(text, sizeof text,
                         "the carriage starts at %.6g m from point 1, outside its travel", l0);
           r.error("travel", text);
-          e.travel.reset();
+          travel.reset();
         }
       }
+      if (travel)
+        e.travel = std::vector<S>{seeded(specs, (*travel)[0], r.at("travel") / 0),
+                                  seeded(specs, (*travel)[1], r.at("travel") / 1)};
     }
     bool ok = name && b1 && b2 && p1 && p2 && p3 && material && section;
     if (name && !claim_element_name(r, *name, specs)) ok = false;
@@ -424,7 +463,10 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
       ok = false;
     }
     if (!ok) return;
-    e.name = *name, e.body1 = *b1, e.body2 = *b2, e.p1 = *p1, e.p2 = *p2, e.p3 = *p3;
+    e.name = *name, e.body1 = *b1, e.body2 = *b2;
+    e.p1 = seeded(specs, *p1, r.at("point1"));
+    e.p2 = seeded(specs, *p2, r.at("point2"));
+    e.p3 = seeded(specs, *p3, r.at("point3"));
     e.material = specs.materials.at(*material);
     e.section = specs.sections.at(*section);
     e.material_name = *material;
@@ -434,12 +476,13 @@ void read_elements(ObjectReader& scene, SceneSpecs& specs, bool rails) {
   });
 }
 
-void read_loads(ObjectReader& scene, SceneSpecs& specs) {
+template <class S>
+void read_loads(ObjectReader& scene, SceneSpecsT<S>& specs) {
   Diagnostics& diag = scene.diagnostics();
   for_each_entry(scene, "loads", [&](const Json& v, const Where& at) {
     ObjectReader r(v, at, diag);
     if (!r.is_object()) return;
-    Load load;
+    LoadT<S> load;
     const auto type = r.choice("type", true, {"force", "torque"});
     if (!type) r.allow({"point", "case", "follows"});
     const auto body = body_ref(r, "body", specs);
@@ -470,23 +513,26 @@ void read_loads(ObjectReader& scene, SceneSpecs& specs) {
     load.body = *body;
     // A follower load keeps the value given (global axes, initial configuration) in body axes.
     load.follows = follows.value_or(false);
+    const Vec3T<S> given = seeded(specs, *value, r.at("value"));
     load.value =
         load.follows
-            ? Vec3(rotation_matrix<double>(specs.bodies[*body].orientation).transpose() * *value)
-            : *value;
+            ? Vec3T<S>(rotation_matrix<S>(specs.bodies[*body].orientation).transpose() * given)
+            : given;
     load.time = *time;
     specs.loads.push_back(load);
-    specs.load_points.push_back(point.value_or(specs.bodies[*body].position));
+    specs.load_points.push_back(point ? seeded(specs, *point, r.at("point"))
+                                      : specs.bodies[*body].position);
     specs.load_where.push_back(at);
   });
 }
 
-void read_joints(ObjectReader& scene, SceneSpecs& specs) {
+template <class S>
+void read_joints(ObjectReader& scene, SceneSpecsT<S>& specs) {
   Diagnostics& diag = scene.diagnostics();
   for_each_entry(scene, "joints", [&](const Json& v, const Where& at) {
     ObjectReader r(v, at, diag);
     if (!r.is_object()) return;
-    JointSpec j;
+    JointSpecT<S> j;
     j.where = at;
     const auto name = r.string("name", true);
     const auto type = r.choice("type", true, {"spherical", "revolute", "fixed"});
@@ -519,11 +565,22 @@ void read_joints(ObjectReader& scene, SceneSpecs& specs) {
     j.type = *type == "spherical"  ? JointType::kSpherical
              : *type == "revolute" ? JointType::kRevolute
                                    : JointType::kFixed;
-    j.body1 = *b1, j.body2 = *b2, j.point = *point;
-    if (axis) j.axis = axis->normalized();
-    if (compliance) j.relative_compliance = *compliance;
+    j.body1 = *b1, j.body2 = *b2, j.point = seeded(specs, *point, r.at("point"));
+    if (axis) j.axis = seeded(specs, *axis, r.at("axis")).normalized();
+    if (compliance) j.relative_compliance = seeded(specs, *compliance, r.at("relative_compliance"));
     specs.joints.push_back(j);
   });
 }
+
+#define BEAMRAIL_READERS(S)                                             \
+  template void read_materials<S>(ObjectReader&, SceneSpecsT<S>&);      \
+  template void read_sections<S>(ObjectReader&, SceneSpecsT<S>&);       \
+  template void read_bodies<S>(ObjectReader&, SceneSpecsT<S>&);         \
+  template void read_elements<S>(ObjectReader&, SceneSpecsT<S>&, bool); \
+  template void read_loads<S>(ObjectReader&, SceneSpecsT<S>&);          \
+  template void read_joints<S>(ObjectReader&, SceneSpecsT<S>&);
+BEAMRAIL_READERS(double)
+BEAMRAIL_READERS(HyperDual)
+#undef BEAMRAIL_READERS
 
 }  // namespace beamrail

@@ -22,7 +22,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // where 1e-5 reaches only 1e-4 for derivatives 1e-4 of their response's relative scale).
 constexpr double kRelativeStep = 1e-4;
 
-bool same_topology(const Model& a, const Model& b) {
+template <class A, class B>
+bool same_topology(const ModelT<A>& a, const ModelT<B>& b) {
   return a.n_dofs == b.n_dofs && a.bodies.size() == b.bodies.size() &&
          a.beams.size() == b.beams.size() && a.rails.size() == b.rails.size() &&
          a.joints.size() == b.joints.size() && a.loads.size() == b.loads.size() &&
@@ -33,13 +34,12 @@ class Sensitivities {
  public:
   Sensitivities(const Study& design, const Evaluation& ev) : design_(design), ev_(ev) {}
 
-  ResponseSensitivities run(const std::vector<const Study*>& plus,
-                            const std::vector<const Study*>& minus, const std::vector<double>& h);
+  ResponseSensitivities run(const std::vector<VariableStep>& steps);
 
  private:
   // Fills the single column of out.jacobian with the derivatives along variable j; false (with
   // out.message) when it cannot.
-  bool variable(int j, const Study& plus, const Study& minus, double h, ResponseSensitivities& out);
+  bool variable(int j, const VariableStep& step, ResponseSensitivities& out);
 
   const Study& design_;
   const Evaluation& ev_;
@@ -51,12 +51,10 @@ Model case_model_of(const Study& study, const std::string& load_case) {
   return model_for_case(study.model, load_case);
 }
 
-ResponseSensitivities Sensitivities::run(const std::vector<const Study*>& plus,
-                                         const std::vector<const Study*>& minus,
-                                         const std::vector<double>& h) {
+ResponseSensitivities Sensitivities::run(const std::vector<VariableStep>& steps) {
   ResponseSensitivities out;
   const int nr = static_cast<int>(design_.responses.size());
-  const int nv = static_cast<int>(h.size());
+  const int nv = static_cast<int>(steps.size());
   out.jacobian = Eigen::MatrixXd::Constant(nr, nv, kNaN);
   if (!ev_.states) {
     out.message = "the evaluation kept no states";
@@ -95,7 +93,7 @@ ResponseSensitivities Sensitivities::run(const std::vector<const Study*>& plus,
 #pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
   for (int j = 0; j < nv; ++j) {
     per[j].jacobian = Eigen::MatrixXd::Constant(nr, 1, kNaN);
-    done[j] = variable(j, *plus[j], *minus[j], h[j], per[j]);
+    done[j] = variable(j, steps[j], per[j]);
   }
   for (int j = 0; j < nv; ++j) {
     if (!done[j]) {
@@ -113,9 +111,11 @@ ResponseSensitivities Sensitivities::run(const std::vector<const Study*>& plus,
   return out;
 }
 
-bool Sensitivities::variable(int j, const Study& plus, const Study& minus, double h,
-                             ResponseSensitivities& out) {
-  if (!same_topology(plus.model, design_.model) || !same_topology(minus.model, design_.model)) {
+bool Sensitivities::variable(int j, const VariableStep& step, ResponseSensitivities& out) {
+  const double h = step.h;
+  if ((step.direction && !same_topology(*step.direction, design_.model)) ||
+      (step.plus && (!same_topology(step.plus->model, design_.model) ||
+                     !same_topology(step.minus->model, design_.model)))) {
     out.message = "variable " + std::to_string(j + 1) +
                   " changes the scene's bodies or elements (a segment count, a fixed flag): no "
                   "derivative";
@@ -127,8 +127,9 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
 
   // du/dp of each equilibrium, on its load case's models.
   std::map<std::string, Eigen::VectorXd> v;
+  // Per load case, the model along the variable (the dual scene's, or from the models at x +- h).
   struct CaseModels {
-    Model plus, minus;
+    Model plus, minus;  // empty without studies at x +- h
     DualModel direction;
     DesignStep step(double h) const { return {&plus, &minus, h, &direction}; }
   };
@@ -136,8 +137,14 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
   const auto models_of = [&](const std::string& load_case) -> const CaseModels& {
     auto it = case_models.find(load_case);
     if (it == case_models.end()) {
-      CaseModels m{case_model_of(plus, load_case), case_model_of(minus, load_case), {}};
-      m.direction = design_direction(case_model_of(design_, load_case), m.plus, m.minus, h);
+      CaseModels m;
+      if (step.plus) {
+        m.plus = case_model_of(*step.plus, load_case);
+        m.minus = case_model_of(*step.minus, load_case);
+      }
+      m.direction = step.direction
+                        ? model_for_case(*step.direction, load_case)
+                        : design_direction(case_model_of(design_, load_case), m.plus, m.minus, h);
       it = case_models.emplace(load_case, std::move(m)).first;
     }
     return it->second;
@@ -199,8 +206,12 @@ bool Sensitivities::variable(int j, const Study& plus, const Study& minus, doubl
         break;
       }
       case AnalysisSpec::Type::kBuckling: {
-        const auto [rp, sp] = buckling_models(plus.model, spec.load_case);
-        const auto [rm, sm] = buckling_models(minus.model, spec.load_case);
+        if (!step.plus) {
+          out.message = "no studies at x +- h for the buckling factors' derivatives";
+          return false;
+        }
+        const auto [rp, sp] = buckling_models(step.plus->model, spec.load_case);
+        const auto [rm, sm] = buckling_models(step.minus->model, spec.load_case);
         const EigenvalueDerivatives d =
             buckling_factor_derivatives(*a.reference, *a.data, {&rp, &rm, h}, {&sp, &sm, h}, du,
                                         a.time, a.eigenvalues, a.shapes);
@@ -232,13 +243,11 @@ double sensitivity_step(double x, double scale) {
 }
 
 ResponseSensitivities response_sensitivities(const Study& design, const Evaluation& ev,
-                                             const std::vector<const Study*>& plus,
-                                             const std::vector<const Study*>& minus,
-                                             const std::vector<double>& h) {
+                                             const std::vector<VariableStep>& steps) {
   Sensitivities s(design, ev);
   ResponseSensitivities out;
   try {
-    out = s.run(plus, minus, h);
+    out = s.run(steps);
   } catch (const std::exception& e) {
     out = ResponseSensitivities();
     out.message = std::string("the sensitivities failed: ") + e.what();

@@ -1,8 +1,11 @@
 // Design sensitivities of a study's responses (docs/study_files.md "Sensitivities", docs/model.md
 // "Design sensitivities"): the derivative of every response of a design with respect to every
-// design variable, from the design's converged results (core/analysis/sensitivity.hpp) and the
-// studies built at x +- h along each variable (their models' partial derivatives; no analysis is
-// run again).
+// design variable, from the design's converged results (core/analysis/sensitivity.hpp) and, per
+// variable, the design's model along it: the scene built on hyper-dual numbers with the variable's
+// numbers seeded (load_dual_scene: forward-mode automatic differentiation through the scene ->
+// model build), or, for a variable that addresses more than the inline scene, from the studies
+// built at x +- h. The derivatives of buckling factors still difference the models of the studies
+// at x +- h. No analysis is run again.
 #pragma once
 
 #include <Eigen/Core>
@@ -28,11 +31,19 @@ struct ResponseSensitivities {
 // magnitude, or to `scale` (the variable's range, or 1) when the value is 0.
 double sensitivity_step(double x, double scale);
 
-// The sensitivities of `design` (evaluated in `ev` with EvaluationOptions::keep_states) from the
-// studies at x + h_j e_j (plus[j]) and x - h_j e_j (minus[j]).
+// What one variable's derivatives are taken from: the design's model along it (directions, when
+// the scene could be built on hyper-dual numbers) and the studies at x + h e_j and x - h e_j
+// (plus, minus: needed without a direction, and by buckling factors).
+struct VariableStep {
+  const DualModel* direction = nullptr;
+  const Study* plus = nullptr;
+  const Study* minus = nullptr;
+  double h = 0.0;
+};
+
+// The sensitivities of `design` (evaluated in `ev` with EvaluationOptions::keep_states), one
+// VariableStep per variable.
 ResponseSensitivities response_sensitivities(const Study& design, const Evaluation& ev,
-                                             const std::vector<const Study*>& plus,
-                                             const std::vector<const Study*>& minus,
-                                             const std::vector<double>& h);
+                                             const std::vector<VariableStep>& steps);
 
 }  // namespace beamrail

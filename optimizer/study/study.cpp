@@ -39,11 +39,6 @@ int find_analysis(const Study& study, const std::string& name) {
   return -1;
 }
 
-Model model_for_case(const Model& model, const std::string& load_case) {
-  return with_loads(
-      model, [&](const Load& load) { return applies_in_case(load, load_case); }, true);
-}
-
 namespace {
 
 // Default names (the type, numbered when repeated); a name used twice is reported where it is

@@ -139,7 +139,11 @@ int find_analysis(const Study& study, const std::string& name);
 
 // The model an analysis of `load_case` sees: the loads without a case and those of the case,
 // gravity (a copy only when the scene has loads of other cases).
-Model model_for_case(const Model& model, const std::string& load_case);
+template <class S>
+ModelT<S> model_for_case(const ModelT<S>& model, const std::string& load_case) {
+  return with_loads(
+      model, [&](const LoadT<S>& load) { return applies_in_case(load, load_case); }, true);
+}
 
 // The analysis types and response quantities a study file may name.
 extern const std::vector<std::string> kAnalysisTypes;

@@ -1,12 +1,14 @@
 #include "core/analysis/sensitivity.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <cmath>
 #include <stdexcept>
 
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
+#include "core/model/jet3.hpp"
 #include "core/model/model_numbers.hpp"
 #include "core/model/rotation.hpp"
 #include "core/model/wrench_assembly.hpp"
@@ -23,37 +25,73 @@ using HVec = Eigen::Matrix<HyperDual, Eigen::Dynamic, 1>;
 
 }  // namespace
 
-std::vector<Pose<HyperDual>> dual_poses(const Model& base, const Data& data,
-                                        const DualModel& direction, const Eigen::VectorXd& v,
-                                        const Eigen::VectorXd& phi) {
-  using H = HyperDual;
-  std::vector<Pose<H>> out(base.bodies.size());
+namespace {
+
+template <class J>
+using JVec = Eigen::Matrix<J, Eigen::Dynamic, 1>;
+
+// The poses of every body on the numbers J of `model` (a model of the scene of `base`): the state
+// of `data` (each body's displacement, and its rotation from its initial orientation applied to
+// `model`'s initial orientation), the free bodies then moved by each of `moves` in turn (J-valued,
+// dim n_dofs, with no value part: X = (dc, theta) gives c + dc and (I + [theta]x) A, exact for
+// nilpotent increments), at rest.
+template <class J>
+std::vector<Pose<J>> moved_poses(const Model& base, const Data& data, const ModelT<J>& model,
+                                 const std::vector<JVec<J>>& moves) {
+  std::vector<Pose<J>> out(base.bodies.size());
   for (size_t i = 0; i < base.bodies.size(); ++i) {
     const Mat3 relative =
         data.pose[i].A * rotation_matrix<double>(base.bodies[i].orientation).transpose();
-    Pose<H>& p = out[i];
-    p.A = relative.cast<H>() * rotation_matrix<H>(direction.bodies[i].orientation);
-    p.u = data.pose[i].u.cast<H>();
-    p.v = Vec3T<H>::Zero();
-    p.omega = Vec3T<H>::Zero();
+    Pose<J>& p = out[i];
+    p.A = relative.cast<J>() * rotation_matrix<J>(model.bodies[i].orientation);
+    p.u = data.pose[i].u.cast<J>();
+    p.v = Vec3T<J>::Zero();
+    p.omega = Vec3T<J>::Zero();
     const int k = base.bodies[i].free_index;
     if (k < 0) continue;
-    // Moved by e x = e (dc, theta): c + e dc and (I + e [theta]x) A, exact for e^2 = 0.
-    const auto move = [&](const Eigen::VectorXd& x, bool e1) {
-      if (x.size() == 0) return;
-      Vec3T<H> dc, theta;
-      for (int r = 0; r < 3; ++r) {
-        const double c = x(kDofsPerBody * k + r), t = x(kDofsPerBody * k + 3 + r);
-        dc(r) = e1 ? H(0.0, c, 0.0, 0.0) : H(0.0, 0.0, c, 0.0);
-        theta(r) = e1 ? H(0.0, t, 0.0, 0.0) : H(0.0, 0.0, t, 0.0);
-      }
-      p.u += dc;
-      p.A = (Mat3T<H>::Identity() + skew<H>(theta)) * p.A;
-    };
-    move(v, false);
-    move(phi, true);
+    for (const JVec<J>& x : moves) {
+      if (x.size() == 0) continue;
+      p.u += x.template segment<3>(kDofsPerBody * k);
+      const Vec3T<J> theta = x.template segment<3>(kDofsPerBody * k + 3);
+      p.A = (Mat3T<J>::Identity() + skew<J>(theta)) * p.A;
+    }
   }
   return out;
+}
+
+// x times the nilpotent unit `unit` (empty stays empty).
+template <class J>
+JVec<J> times(const Eigen::VectorXd& x, const J& unit) {
+  JVec<J> out(x.size());
+  for (Eigen::Index r = 0; r < x.size(); ++r) out(r) = x(r) * unit;
+  return out;
+}
+
+// The generalized forces (dim n_dofs) of the elements (when `elements`) and the loads of `model`
+// at the poses, at time t with the loads scaled by load_factor.
+template <class J>
+JVec<J> generalized_forces(const Model& base, const ModelT<J>& model,
+                           const std::vector<Pose<J>>& poses, double t, double load_factor,
+                           bool elements) {
+  if (model.bodies.size() != base.bodies.size() || model.n_dofs != base.n_dofs)
+    throw std::invalid_argument("the design direction's model has other bodies than the design's");
+  std::vector<Vec6T<J>> wrench(base.bodies.size(), Vec6T<J>::Zero());
+  add_load_wrenches(model, poses, t, load_factor, wrench);
+  if (elements) add_element_wrenches(model, poses, wrench);
+  JVec<J> out(base.n_dofs);
+  for (int k = 0; k < base.n_free(); ++k)
+    out.template segment<6>(kDofsPerBody * k) = wrench[base.free_bodies[k]];
+  return out;
+}
+
+const HyperDual kE1(0.0, 1.0, 0.0, 0.0), kE2(0.0, 0.0, 1.0, 0.0);
+
+}  // namespace
+
+std::vector<Pose<HyperDual>> dual_poses(const Model& base, const Data& data,
+                                        const DualModel& direction, const Eigen::VectorXd& v,
+                                        const Eigen::VectorXd& phi) {
+  return moved_poses<HyperDual>(base, data, direction, {times(v, kE2), times(phi, kE1)});
 }
 
 DualModel design_direction(const Model& base, const Model& plus, const Model& minus, double h) {
@@ -67,16 +105,8 @@ DualModel design_direction(const Model& base, const Model& plus, const Model& mi
 HVec dual_generalized_forces(const Model& base, const Data& data, const DualModel& direction,
                              const Eigen::VectorXd& v, const Eigen::VectorXd& phi, double t,
                              double load_factor) {
-  if (direction.bodies.size() != base.bodies.size() || direction.n_dofs != base.n_dofs)
-    throw std::invalid_argument("dual_generalized_forces: the models have different bodies");
-  const std::vector<Pose<HyperDual>> poses = dual_poses(base, data, direction, v, phi);
-  std::vector<Vec6T<HyperDual>> wrench(base.bodies.size(), Vec6T<HyperDual>::Zero());
-  add_load_wrenches(direction, poses, t, load_factor, wrench);
-  add_element_wrenches(direction, poses, wrench);
-  HVec out(base.n_dofs);
-  for (int k = 0; k < base.n_free(); ++k)
-    out.segment<6>(kDofsPerBody * k) = wrench[base.free_bodies[k]];
-  return out;
+  return generalized_forces(base, direction, dual_poses(base, data, direction, v, phi), t,
+                            load_factor, true);
 }
 
 void transplant_state(const Model& from_model, const Data& from, const Model& to_model, Data& to) {
@@ -136,16 +166,6 @@ Eigen::VectorXd EquilibriumSensitivity::state_derivative(const DesignStep& step)
   return v;
 }
 
-double directional_derivative(const Model& base_model, const Data& base, const DesignStep& step,
-                              const Eigen::VectorXd& v,
-                              const std::function<double(const Model&, const Data&)>& q) {
-  const Eigen::VectorXd forward = v.size() > 0 ? Eigen::VectorXd(step.h * v) : Eigen::VectorXd();
-  const Eigen::VectorXd backward = v.size() > 0 ? Eigen::VectorXd(-step.h * v) : Eigen::VectorXd();
-  const double up = q(*step.plus, moved_state(base_model, base, *step.plus, forward));
-  const double down = q(*step.minus, moved_state(base_model, base, *step.minus, backward));
-  return (up - down) / (2.0 * step.h);
-}
-
 namespace {
 
 // The derivatives of the eigenvalues `values` (ascending) of a symmetric problem, cluster by
@@ -197,10 +217,6 @@ EigenvalueDerivatives cluster_derivatives(
   return out;
 }
 
-Eigen::VectorXd scaled(const Eigen::VectorXd& v, double s) {
-  return v.size() > 0 ? Eigen::VectorXd(s * v) : Eigen::VectorXd();
-}
-
 }  // namespace
 
 EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data& base,
@@ -242,22 +258,72 @@ EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data
 }
 
 EigenvalueDerivatives buckling_factor_derivatives(const Model& reference, const Data& base,
-                                                  const DesignStep& reference_step,
-                                                  const DesignStep& scaled_step,
+                                                  const DualModel& reference_direction,
+                                                  const DualModel& scaled_direction,
                                                   const Eigen::VectorXd& v, double t,
                                                   const std::vector<double>& factors,
                                                   const Eigen::MatrixXd& shapes) {
-  const auto at = [&](const Model& r, const Model& s, double sign) {
-    Data d = moved_state(reference, base, r, scaled(v, sign * reference_step.h));
-    compute_wrenches(r, d, t, 1.0);
-    return buckling_matrices(r, s, t, d, false);
-  };
-  const BucklingMatrices plus = at(*reference_step.plus, *scaled_step.plus, 1.0);
-  const BucklingMatrices minus = at(*reference_step.minus, *scaled_step.minus, -1.0);
-  const double h2 = 2.0 * reference_step.h;
-  const Eigen::MatrixXd dk0_phi = (plus.k0 * shapes - minus.k0 * shapes) / h2;
-  const Eigen::MatrixXd dk1_phi = (plus.k1 * shapes - minus.k1 * shapes) / h2;
-  const Eigen::MatrixXd k1_phi = 0.5 * (plus.k1 * shapes + minus.k1 * shapes);
+  using H = HyperDual;
+  const int n = reference.n_dofs;
+  const Eigen::VectorXd none;
+  // K0 at the reference state, with its constant loads' stiffness (as the analysis builds it).
+  Data d = base;
+  compute_wrenches(reference, d, t, 1.0);
+  compute_tangent(reference, d, t, false, 1.0);
+  const Eigen::SparseMatrix<double> k0 =
+      symmetric_stiffness(reference, d, Eigen::VectorXd::Ones(n), nullptr);
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factor(k0);
+  if (factor.info() != Eigen::Success)
+    throw std::runtime_error("the reference state's tangent stiffness could not be factored");
+  // The scaled loads P1 at the reference state and dP1/dp (through du0/dp too); u1 = K0^-1 P1,
+  // the motion per unit load factor, and du1/dp = K0^-1 (dP1/dp - dK0/dp u1) (K0 symmetric for
+  // the conservative loads buckling admits, so dK0/dp u1 is the e1 e2 part along u1).
+  const HVec p1 = generalized_forces(
+      reference, scaled_direction,
+      moved_poses<H>(reference, base, scaled_direction, {times(v, kE2)}), t, 1.0, false);
+  Eigen::VectorXd p1_value(n), dp1(n);
+  for (int r = 0; r < n; ++r) p1_value(r) = p1(r).v, dp1(r) = p1(r).b;
+  const Eigen::VectorXd u1 = factor.solve(p1_value);
+  const HVec along_u1 =
+      dual_generalized_forces(reference, base, reference_direction, v, u1, t, 1.0);
+  Eigen::VectorXd dk0_u1(n);
+  for (int r = 0; r < n; ++r) dk0_u1(r) = -along_u1(r).ab;
+  const Eigen::VectorXd w1 = factor.solve(Eigen::VectorXd(dp1 - dk0_u1));
+
+  // Per mode: dK0/dp phi (e1 e2 of W0 along phi), and K1 phi, dK1/dp phi. K1 is the change of the
+  // tangent along u1 plus the scaled loads' stiffness: -(d2 W0/du2 [phi, u1] + dW1/du phi); on
+  // third-order jets with e1 the mode, e3 the motion u1 (+ e2 du1/dp) and e2 the design, the
+  // e1 e3 part is the first term and the e1 e2 e3 part its derivative along the design.
+  const ModelT<Jet3> jet_model = zip_numbers<Jet3>(
+      [](const H& x) {
+        Jet3 j(x.v);
+        j.c[2] = x.b;
+        return j;
+      },
+      reference_direction);
+  Jet3 e1, e2, e3, e23;
+  e1.c[1] = 1.0, e2.c[2] = 1.0, e3.c[4] = 1.0, e23.c[6] = 1.0;
+  JVec<Jet3> motion = times(u1, e3);
+  motion += times(w1, e23);
+  const int m = static_cast<int>(shapes.cols());
+  Eigen::MatrixXd dk0_phi(n, m), k1_phi(n, m), dk1_phi(n, m);
+  for (int j = 0; j < m; ++j) {
+    const Eigen::VectorXd phi = shapes.col(j);
+    const HVec w0 = dual_generalized_forces(reference, base, reference_direction, v, phi, t, 1.0);
+    const HVec ws = generalized_forces(
+        reference, scaled_direction,
+        moved_poses<H>(reference, base, scaled_direction, {times(v, kE2), times(phi, kE1)}), t, 1.0,
+        false);
+    const JVec<Jet3> wj = generalized_forces(
+        reference, jet_model,
+        moved_poses<Jet3>(reference, base, jet_model, {times(v, e2), motion, times(phi, e1)}), t,
+        1.0, true);
+    for (int r = 0; r < n; ++r) {
+      dk0_phi(r, j) = -w0(r).ab;
+      k1_phi(r, j) = -(wj(r).c[5] + ws(r).a);
+      dk1_phi(r, j) = -(wj(r).c[7] + ws(r).ab);
+    }
+  }
   // (K0 + lambda K1) phi = 0: phi^T (dK0 + lambda dK1) phi + dlambda phi^T K1 phi = 0.
   return cluster_derivatives(factors, [&](int first, int last, double mean) {
     const int size = last - first + 1;

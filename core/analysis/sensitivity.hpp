@@ -9,15 +9,14 @@
 // of the products K phi and M phi are exact: the element kernels, the loads and the masses run on
 // hyper-dual numbers (core/model/hyper_dual.hpp) over the model along the design direction (a
 // DualModel: each number's value and its derivative dm/dp), with the state seeded by its own
-// derivative du/dp and, for K phi, by the mode phi. The DualModel's derivatives dm/dp come from
-// the models built at p + h and p - h (design_direction), as do those of the buckling factors and
-// of the responses read from an equilibrium (central differences of the models' quantities at one
-// fixed state: smooth in p and evaluated to rounding, so the steps can be small; no analysis is
-// repeated). Everything that depends on the state follows the exact formulas:
+// derivative du/dp and, for K phi, by the mode phi. The DualModel comes from the scene built on
+// hyper-dual numbers (load_dual_scene, core/scene/scene_loader.hpp). No analysis is repeated.
+// Everything that depends on the state follows the exact formulas:
 //
 //  - static equilibrium W(u(p), p) = 0: du/dp = -S^-1 dW/dp|_u with S = dW/du the tangent at the
 //    equilibrium (one solve per parameter with one factorization);
-//  - a response r(u, p) of the equilibrium: dr/dp = d/dh r(u + h du/dp, p + h) at h = 0, the
+//  - a response r(u, p) of the equilibrium: dr/dp = d/dh r(u + h du/dp, p + h) at h = 0 (the e2
+//    part of r on the DualModel at the state moved by e2 du/dp), the
 //    derivative along the design direction (central difference of r at two states);
 //  - an eigenvalue of K phi = lambda M phi (M-normalized phi) about the equilibrium:
 //    dlambda/dp = phi^T (dK/dp - lambda dM/dp) phi, dK/dp and dM/dp the total derivatives along
@@ -26,7 +25,7 @@
 //    Phi^T (dK - lambda dM) Phi over its modes (the directional derivatives as p grows), assigned
 //    in ascending order, and the result says so;
 //  - a buckling factor of (K0 + lambda K1) phi = 0: dlambda/dp = -phi^T (dK0 + lambda dK1) phi /
-//    (phi^T K1 phi).
+//    (phi^T K1 phi), K1's derivative on third-order jets (core/model/jet3.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -64,14 +63,12 @@ Data moved_state(const Model& base_model, const Data& base, const Model& model,
 // load_dual_scene (core/scene/scene_loader.hpp), or from the models at p +- h.
 
 // The DualModel of `base` from the models at p + h and p - h: the values of base, the derivatives
-// (plus - minus) / 2h (0 where plus and minus agree, infinite travel limits included).
+// (plus - minus) / 2h (0 where plus and minus agree, infinite travel limits included). Only the
+// numbers: a direction for checks (the tests), where load_dual_scene is the exact one.
 DualModel design_direction(const Model& base, const Model& plus, const Model& minus, double h);
 
-// The models at p + h and p - h, and the model along the design direction.
+// The model along the design direction.
 struct DesignStep {
-  const Model* plus = nullptr;
-  const Model* minus = nullptr;
-  double h = 0.0;
   const DualModel* direction = nullptr;
 };
 
@@ -112,13 +109,6 @@ class EquilibriumSensitivity {
   std::string failure_;
 };
 
-// d/dh q(state + h v, p + h) at h = 0 by a central difference, for q evaluated on a model and a
-// state: the total derivative of q along the design direction (v = du/dp, or empty when the state
-// does not depend on p).
-double directional_derivative(const Model& base_model, const Data& base, const DesignStep& step,
-                              const Eigen::VectorXd& v,
-                              const std::function<double(const Model&, const Data&)>& q);
-
 struct EigenvalueDerivatives {
   std::vector<double> values;  // dlambda/dp per eigenvalue given
   // Per eigenvalue: 0 alone, 1 near a crossing (within kNearCrossing of another), 2 in a cluster
@@ -138,12 +128,15 @@ EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data
                                              const Eigen::MatrixXd& shapes);
 
 // The derivatives of the buckling factors `factors` (ascending, every one computed) with shapes
-// `shapes` (columns) about the reference state `base` (data of `reference`); the design steps give
-// the reference structure (its constant loads) and the structure with the loads to scale at
-// p +- h; v = du/dp of the reference state (empty when it is the unloaded initial state).
+// `shapes` (columns) about the reference state `base` (data of `reference`), exact: the models
+// along the design direction of the reference structure and of the structure with the loads to
+// scale (values those of `reference` and the scaled structure), v = du/dp of the reference state
+// (empty when it is the unloaded initial state). K1 is the tangent's change along u1 = K0^-1 P1
+// plus the scaled loads' stiffness; its derivative along the design (through du0/dp and du1/dp)
+// comes from third-order jets (core/model/jet3.hpp).
 EigenvalueDerivatives buckling_factor_derivatives(const Model& reference, const Data& base,
-                                                  const DesignStep& reference_step,
-                                                  const DesignStep& scaled_step,
+                                                  const DualModel& reference_direction,
+                                                  const DualModel& scaled_direction,
                                                   const Eigen::VectorXd& v, double t,
                                                   const std::vector<double>& factors,
                                                   const Eigen::MatrixXd& shapes);

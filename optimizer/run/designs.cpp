@@ -60,61 +60,42 @@ ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& 
                                                      const Evaluation& ev) const {
   const auto& variables = study_.design->variables;
   const int nv = static_cast<int>(variables.size());
-  std::vector<VariableStep> steps(nv);
+  ResponseSensitivities out;
+  // The derivatives follow the scene's numbers: a variable elsewhere (an analysis's option, a
+  // response's direction) changes what the analyses compute, not the model.
   for (int j = 0; j < nv; ++j)
-    steps[j].h = sensitivity_step(x[j], variables[j].upper - variables[j].lower);
-  // The design's model along each variable, by automatic differentiation of the scene's build,
-  // when every variable addresses the inline scene.
-  std::vector<std::optional<DualModel>> directions(nv);
-  std::vector<std::string> invalid(2 * nv);
-  if (scene_only_) {
-    const Json doc = document(x);
-    const Where scene = Where{study_.file, ""} / "scene";
-#pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
-    for (int j = 0; j < nv; ++j) {
-      std::map<std::string, double> seeds;
-      for (size_t k = 0; k < pointers_[j].size(); ++k)
-        seeds[pointers_[j][k].to_string()] += variables[j].factors[k];
-      // A variable the build does not differentiate (its numbers not read as design numbers) is
-      // differenced below.
-      Diagnostics diag;
-      directions[j] =
-          load_dual_scene(doc.at("scene"), scene, seeds, design.model.segment_choices, diag);
-    }
-  }
-  // The studies at x +- h_j e_j where a derivative still differences models: variables beyond the
-  // inline scene or whose numbers the build does not differentiate (a time function's
-  // parameter), and buckling factors. Built in parallel (one thread inside a parallel batch).
-  bool differences = !scene_only_;
-  for (const AnalysisSpec& a : design.analyses)
-    differences = differences || a.type == AnalysisSpec::Type::kBuckling;
-  for (int j = 0; j < nv; ++j) differences = differences || !directions[j];
-  std::vector<std::optional<Study>> plus(nv), minus(nv);
-  if (differences) {
-#pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
-    for (int i = 0; i < 2 * nv; ++i) {
-      const int j = i / 2;
-      std::vector<double> at = x;
-      at[j] += (i % 2 == 0 ? 1.0 : -1.0) * steps[j].h;
-      Diagnostics diag;
-      auto& out = i % 2 == 0 ? plus[j] : minus[j];
-      out = build(at, diag);
-      if (!out) invalid[i] = problems(diag);
-    }
-    for (int i = 0; i < 2 * nv; ++i)
-      if (!invalid[i].empty()) {
-        ResponseSensitivities out;
-        out.message = "no derivative with respect to \"" + variables[i / 2].name +
-                      "\": the design a step of " + format_number(steps[i / 2].h) +
-                      " away is invalid: " + invalid[i];
+    for (const std::string& p : variables[j].pointers)
+      if (p.rfind("/scene/", 0) != 0) {
+        out.message = "no exact derivative with respect to \"" + variables[j].name + "\": " + p +
+                      " is not a number of the inline scene (use \"gradient\": \"fd\")";
         return out;
       }
-  }
+  // The design's model along each variable: its scene built on hyper-dual numbers, the
+  // variable's numbers seeded with their factors.
+  std::vector<std::optional<DualModel>> directions(nv);
+  std::vector<std::string> refused(nv);
+  const Json doc = document(x);
+  const Where scene = Where{study_.file, ""} / "scene";
+#pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
   for (int j = 0; j < nv; ++j) {
-    if (directions[j]) steps[j].direction = &*directions[j];
-    if (plus[j]) steps[j].plus = &*plus[j], steps[j].minus = &*minus[j];
+    std::map<std::string, double> seeds;
+    for (size_t k = 0; k < pointers_[j].size(); ++k)
+      seeds[pointers_[j][k].to_string()] += variables[j].factors[k];
+    Diagnostics diag;
+    directions[j] =
+        load_dual_scene(doc.at("scene"), scene, seeds, design.model.segment_choices, diag);
+    if (!directions[j]) refused[j] = problems(diag);
   }
-  return response_sensitivities(design, ev, steps);
+  std::vector<DualModel> along;
+  for (int j = 0; j < nv; ++j) {
+    if (!directions[j]) {
+      out.message = "no exact derivative with respect to \"" + variables[j].name +
+                    "\": " + refused[j] + " (use \"gradient\": \"fd\")";
+      return out;
+    }
+    along.push_back(std::move(*directions[j]));
+  }
+  return response_sensitivities(design, ev, along);
 }
 
 std::optional<Study> DesignEvaluator::build(const std::vector<double>& x, Diagnostics& diag) const {

@@ -37,9 +37,9 @@ class DesignEvaluator {
   const std::string& setup_failure() const { return setup_failure_; }
 
   // Thread-safe: reads only the evaluator's constant state. With `sensitivities`, also the
-  // derivatives of every response with respect to every variable at x (the designs at x +- h
-  // along each variable are built, not analysed: optimizer/run/sensitivities.hpp); they are left
-  // !ok with a message when the design did not evaluate or has none.
+  // derivatives of every response with respect to every variable at x (the design's scene built
+  // once more per variable on hyper-dual numbers, not analysed: optimizer/run/sensitivities.hpp);
+  // they are left !ok with a message when the design did not evaluate or has none.
   DesignOutcome evaluate(const std::vector<double>& x,
                          ResponseSensitivities* sensitivities = nullptr) const;
 

@@ -448,19 +448,6 @@ class Runner {
 
 }  // namespace
 
-std::pair<Model, Model> buckling_models(const Model& model, const std::string& load_case) {
-  Model reference = load_case.empty() ? with_loads(
-                                            model, [](const Load&) { return false; }, false)
-                                      : model_for_case(model, "");
-  Model scaled = with_loads(
-      model,
-      [&](const Load& load) {
-        return load_case.empty() ? load.load_case.empty() : load.load_case == load_case;
-      },
-      load_case.empty());
-  return {std::move(reference), std::move(scaled)};
-}
-
 Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Evaluation ev;

@@ -113,7 +113,20 @@ struct EvaluationStates {
 // The structure a buckling analysis of `load_case` holds at its reference (its constant loads:
 // those without a case and gravity; none when the case is "") and the structure with the loads it
 // scales (those of the case; without a case, those without one and gravity).
-std::pair<Model, Model> buckling_models(const Model& model, const std::string& load_case);
+template <class S>
+std::pair<ModelT<S>, ModelT<S>> buckling_models(const ModelT<S>& model,
+                                                const std::string& load_case) {
+  ModelT<S> reference = load_case.empty() ? with_loads(
+                                                model, [](const LoadT<S>&) { return false; }, false)
+                                          : model_for_case(model, "");
+  ModelT<S> scaled = with_loads(
+      model,
+      [&](const LoadT<S>& load) {
+        return load_case.empty() ? load.load_case.empty() : load.load_case == load_case;
+      },
+      load_case.empty());
+  return {std::move(reference), std::move(scaled)};
+}
 
 struct Evaluation {
   Status status = Status::kOk;

@@ -15,13 +15,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Relative step of the models' differences. Their quantities are smooth in p and evaluated to
-// rounding at one fixed state: the truncation error is ~ step^2, the rounding error ~ eps / step
-// times the cancellation in the element forces (measured in tests/optimizer/sensitivities_test:
-// 1e-4 agrees with extrapolated central differences of the responses to 1e-9 .. 1e-6 on a frame
-// where 1e-5 reaches only 1e-4 for derivatives 1e-4 of their response's relative scale).
-constexpr double kRelativeStep = 1e-4;
-
 template <class A, class B>
 bool same_topology(const ModelT<A>& a, const ModelT<B>& b) {
   return a.n_dofs == b.n_dofs && a.bodies.size() == b.bodies.size() &&
@@ -34,27 +27,22 @@ class Sensitivities {
  public:
   Sensitivities(const Study& design, const Evaluation& ev) : design_(design), ev_(ev) {}
 
-  ResponseSensitivities run(const std::vector<VariableStep>& steps);
+  ResponseSensitivities run(const std::vector<DualModel>& directions);
 
  private:
-  // Fills the single column of out.jacobian with the derivatives along variable j; false (with
-  // out.message) when it cannot.
-  bool variable(int j, const VariableStep& step, ResponseSensitivities& out);
+  // Fills the single column of out.jacobian with the derivatives along variable j (the design's
+  // model along it: `direction`); false (with out.message) when it cannot.
+  bool variable(int j, const DualModel& direction, ResponseSensitivities& out);
 
   const Study& design_;
   const Evaluation& ev_;
   std::map<std::string, std::unique_ptr<EquilibriumSensitivity>> equilibria_;
 };
 
-// The model of `study` an analysis of `load_case` sees (as the evaluation's case_model).
-Model case_model_of(const Study& study, const std::string& load_case) {
-  return model_for_case(study.model, load_case);
-}
-
-ResponseSensitivities Sensitivities::run(const std::vector<VariableStep>& steps) {
+ResponseSensitivities Sensitivities::run(const std::vector<DualModel>& directions) {
   ResponseSensitivities out;
   const int nr = static_cast<int>(design_.responses.size());
-  const int nv = static_cast<int>(steps.size());
+  const int nv = static_cast<int>(directions.size());
   out.jacobian = Eigen::MatrixXd::Constant(nr, nv, kNaN);
   if (!ev_.states) {
     out.message = "the evaluation kept no states";
@@ -93,7 +81,7 @@ ResponseSensitivities Sensitivities::run(const std::vector<VariableStep>& steps)
 #pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
   for (int j = 0; j < nv; ++j) {
     per[j].jacobian = Eigen::MatrixXd::Constant(nr, 1, kNaN);
-    done[j] = variable(j, steps[j], per[j]);
+    done[j] = variable(j, directions[j], per[j]);
   }
   for (int j = 0; j < nv; ++j) {
     if (!done[j]) {
@@ -111,11 +99,8 @@ ResponseSensitivities Sensitivities::run(const std::vector<VariableStep>& steps)
   return out;
 }
 
-bool Sensitivities::variable(int j, const VariableStep& step, ResponseSensitivities& out) {
-  const double h = step.h;
-  if ((step.direction && !same_topology(*step.direction, design_.model)) ||
-      (step.plus && (!same_topology(step.plus->model, design_.model) ||
-                     !same_topology(step.minus->model, design_.model)))) {
+bool Sensitivities::variable(int j, const DualModel& direction, ResponseSensitivities& out) {
+  if (!same_topology(direction, design_.model)) {
     out.message = "variable " + std::to_string(j + 1) +
                   " changes the scene's bodies or elements (a segment count, a fixed flag): no "
                   "derivative";
@@ -127,26 +112,12 @@ bool Sensitivities::variable(int j, const VariableStep& step, ResponseSensitivit
 
   // du/dp of each equilibrium, on its load case's models.
   std::map<std::string, Eigen::VectorXd> v;
-  // Per load case, the model along the variable (the dual scene's, or from the models at x +- h).
-  struct CaseModels {
-    Model plus, minus;  // empty without studies at x +- h
-    DualModel direction;
-    DesignStep step(double h) const { return {&plus, &minus, h, &direction}; }
-  };
-  std::map<std::string, CaseModels> case_models;
-  const auto models_of = [&](const std::string& load_case) -> const CaseModels& {
+  // Per load case, the model along the variable an analysis of the case sees.
+  std::map<std::string, DualModel> case_models;
+  const auto models_of = [&](const std::string& load_case) -> const DualModel& {
     auto it = case_models.find(load_case);
-    if (it == case_models.end()) {
-      CaseModels m;
-      if (step.plus) {
-        m.plus = case_model_of(*step.plus, load_case);
-        m.minus = case_model_of(*step.minus, load_case);
-      }
-      m.direction = step.direction
-                        ? model_for_case(*step.direction, load_case)
-                        : design_direction(case_model_of(design_, load_case), m.plus, m.minus, h);
-      it = case_models.emplace(load_case, std::move(m)).first;
-    }
+    if (it == case_models.end())
+      it = case_models.emplace(load_case, model_for_case(direction, load_case)).first;
     return it->second;
   };
   const auto state_derivative = [&](const std::string& key) -> const Eigen::VectorXd* {
@@ -159,7 +130,7 @@ bool Sensitivities::variable(int j, const VariableStep& step, ResponseSensitivit
       out.message = s.failure();
       return nullptr;
     }
-    return &v.emplace(key, s.state_derivative(models_of(e.load_case).step(h))).first->second;
+    return &v.emplace(key, s.state_derivative({&models_of(e.load_case)})).first->second;
   };
 
   for (size_t i = 0; i < design_.analyses.size(); ++i) {
@@ -178,15 +149,15 @@ bool Sensitivities::variable(int j, const VariableStep& step, ResponseSensitivit
       case AnalysisSpec::Type::kStatic: {
         const EvaluationStates::Equilibrium& e = states.equilibria.at(a.equilibrium);
         std::vector<double> d(nr, kNaN);
-        static_response_derivatives(design_, index, *e.model, *e.data,
-                                    models_of(spec.load_case).direction, du, d);
+        static_response_derivatives(design_, index, *e.model, *e.data, models_of(spec.load_case),
+                                    du, d);
         for (int k = 0; k < nr; ++k)
           if (design_.responses[k].analysis == index) column(k) = d[k];
         break;
       }
       case AnalysisSpec::Type::kModal: {
         const EigenvalueDerivatives d =
-            eigenvalue_derivatives(*a.model, *a.data, models_of(spec.load_case).step(h), du, a.time,
+            eigenvalue_derivatives(*a.model, *a.data, {&models_of(spec.load_case)}, du, a.time,
                                    a.load_factor, a.eigenvalues, a.shapes);
         for (int k = 0; k < nr; ++k) {
           const int m = a.response_mode[k];
@@ -206,15 +177,9 @@ bool Sensitivities::variable(int j, const VariableStep& step, ResponseSensitivit
         break;
       }
       case AnalysisSpec::Type::kBuckling: {
-        if (!step.plus) {
-          out.message = "no studies at x +- h for the buckling factors' derivatives";
-          return false;
-        }
-        const auto [rp, sp] = buckling_models(step.plus->model, spec.load_case);
-        const auto [rm, sm] = buckling_models(step.minus->model, spec.load_case);
-        const EigenvalueDerivatives d =
-            buckling_factor_derivatives(*a.reference, *a.data, {&rp, &rm, h}, {&sp, &sm, h}, du,
-                                        a.time, a.eigenvalues, a.shapes);
+        const auto [reference, scaled] = buckling_models(direction, spec.load_case);
+        const EigenvalueDerivatives d = buckling_factor_derivatives(
+            *a.reference, *a.data, reference, scaled, du, a.time, a.eigenvalues, a.shapes);
         for (int k = 0; k < nr; ++k) {
           const int m = a.response_mode[k];
           if (m < 0) continue;
@@ -232,22 +197,18 @@ bool Sensitivities::variable(int j, const VariableStep& step, ResponseSensitivit
   }
   for (int k = 0; k < nr; ++k)
     if (design_.responses[k].quantity == ResponseSpec::Quantity::kMass)
-      column(k) = mass_response(models_of("").direction, design_.responses[k]).b;
+      column(k) = mass_response(direction, design_.responses[k]).b;
   return true;
 }
 
 }  // namespace
 
-double sensitivity_step(double x, double scale) {
-  return kRelativeStep * (x != 0.0 ? std::abs(x) : (scale > 0.0 ? scale : 1.0));
-}
-
 ResponseSensitivities response_sensitivities(const Study& design, const Evaluation& ev,
-                                             const std::vector<VariableStep>& steps) {
+                                             const std::vector<DualModel>& directions) {
   Sensitivities s(design, ev);
   ResponseSensitivities out;
   try {
-    out = s.run(steps);
+    out = s.run(directions);
   } catch (const std::exception& e) {
     out = ResponseSensitivities();
     out.message = std::string("the sensitivities failed: ") + e.what();

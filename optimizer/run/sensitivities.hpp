@@ -3,9 +3,9 @@
 // design variable, from the design's converged results (core/analysis/sensitivity.hpp) and, per
 // variable, the design's model along it: the scene built on hyper-dual numbers with the variable's
 // numbers seeded (load_dual_scene: forward-mode automatic differentiation through the scene ->
-// model build), or, for a variable that addresses more than the inline scene, from the studies
-// built at x +- h. The derivatives of buckling factors still difference the models of the studies
-// at x +- h. No analysis is run again.
+// model build). No analysis is run again. A variable that addresses more than the inline scene, or
+// a number the build does not differentiate (a segment count, a time function's parameter), has
+// no exact derivative: the study says so (gradient algorithms then take "gradient": "fd").
 #pragma once
 
 #include <Eigen/Core>
@@ -27,23 +27,9 @@ struct ResponseSensitivities {
   std::vector<std::string> warnings;  // a response on or near a crossing of modes, ...
 };
 
-// The step of variable value x along which the models are differenced: relative to the value's
-// magnitude, or to `scale` (the variable's range, or 1) when the value is 0.
-double sensitivity_step(double x, double scale);
-
-// What one variable's derivatives are taken from: the design's model along it (directions, when
-// the scene could be built on hyper-dual numbers) and the studies at x + h e_j and x - h e_j
-// (plus, minus: needed without a direction, and by buckling factors).
-struct VariableStep {
-  const DualModel* direction = nullptr;
-  const Study* plus = nullptr;
-  const Study* minus = nullptr;
-  double h = 0.0;
-};
-
-// The sensitivities of `design` (evaluated in `ev` with EvaluationOptions::keep_states), one
-// VariableStep per variable.
+// The sensitivities of `design` (evaluated in `ev` with EvaluationOptions::keep_states) along
+// the design's models along each variable (load_dual_scene).
 ResponseSensitivities response_sensitivities(const Study& design, const Evaluation& ev,
-                                             const std::vector<VariableStep>& steps);
+                                             const std::vector<DualModel>& directions);
 
 }  // namespace beamrail

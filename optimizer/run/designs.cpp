@@ -66,8 +66,9 @@ ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& 
   for (int j = 0; j < nv; ++j)
     for (const std::string& p : variables[j].pointers)
       if (p.rfind("/scene/", 0) != 0) {
-        out.message = "no exact derivative with respect to \"" + variables[j].name + "\": " + p +
-                      " is not a number of the inline scene (use \"gradient\": \"fd\")";
+        out.message =
+            "no exact derivative with respect to \"" + variables[j].name + "\": " + p +
+            " is not a number of the inline scene (an optimization can take \"gradient\": \"fd\")";
         return out;
       }
   // The design's model along each variable: its scene built on hyper-dual numbers, the
@@ -90,7 +91,7 @@ ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& 
   for (int j = 0; j < nv; ++j) {
     if (!directions[j]) {
       out.message = "no exact derivative with respect to \"" + variables[j].name +
-                    "\": " + refused[j] + " (use \"gradient\": \"fd\")";
+                    "\": " + refused[j] + " (an optimization can take \"gradient\": \"fd\")";
       return out;
     }
     along.push_back(std::move(*directions[j]));

@@ -134,7 +134,7 @@ struct LoadT {
   // A follower load: its value is fixed in the body frame and turns with the body (global value
   // A value); otherwise its direction stays fixed in global axes.
   bool follows = false;
-  TimeFunction time;
+  TimeFunctionT<S> time;
   std::string load_case;  // the load case it belongs to; empty: none (applied by every analysis)
 };
 using Load = LoadT<double>;

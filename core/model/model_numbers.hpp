@@ -119,7 +119,19 @@ ModelT<T> zip_numbers(F&& f, const ModelT<S0>& first, const ModelT<S>&... others
   for (size_t i = 0; i < first.loads.size(); ++i) {
     const LoadT<S0>& l0 = first.loads[i];
     LoadT<T>& o = out.loads[i];
-    o.kind = l0.kind, o.body = l0.body, o.follows = l0.follows, o.time = l0.time;
+    o.kind = l0.kind, o.body = l0.body, o.follows = l0.follows;
+    o.time.type = static_cast<typename TimeFunctionT<T>::Type>(l0.time.type);
+    number(f, o.time.at, l0.time.at, others.loads[i].time.at...);
+    number(f, o.time.from, l0.time.from, others.loads[i].time.from...);
+    number(f, o.time.to, l0.time.to, others.loads[i].time.to...);
+    number(f, o.time.frequency, l0.time.frequency, others.loads[i].time.frequency...);
+    number(f, o.time.phase, l0.time.phase, others.loads[i].time.phase...);
+    o.time.t.resize(l0.time.t.size());
+    for (size_t k = 0; k < l0.time.t.size(); ++k)
+      number(f, o.time.t[k], l0.time.t[k], others.loads[i].time.t[k]...);
+    o.time.v.resize(l0.time.v.size());
+    for (size_t k = 0; k < l0.time.v.size(); ++k)
+      number(f, o.time.v[k], l0.time.v[k], others.loads[i].time.v[k]...);
     o.load_case = l0.load_case;
     number(f, o.offset, l0.offset, others.loads[i].offset...);
     number(f, o.value, l0.value, others.loads[i].value...);

@@ -351,8 +351,8 @@ std::optional<ModelT<S>> build_scene(const Json& scene, const Where& where, Diag
   for (const auto& [pointer, derivative] : specs.seeds)
     if (!specs.seeds_read.count(pointer))
       diag.error(where.file, pointer,
-                 "not a number the scene's build differentiates (a count, a flag, a time "
-                 "function's parameter, or no number of the scene)");
+                 "not a number the scene's build differentiates (a segment count, the "
+                 "segmentation target, or no number of the scene)");
   if (diag.size() > errors_before) return std::nullopt;
   std::vector<SegmentChoice> choices;
   choose_auto_segments(specs, target, pinned, diag, choices);

@@ -28,7 +28,7 @@ std::optional<Model> load_scene(const Json& scene, const Where& where, Diagnosti
 // respect to the design parameter. For a scene that load_scene built without errors, with its
 // "auto" segment counts in `pinned`; reports problems as load_scene does but checks only what its
 // reading checks, and reports a seed that addresses no number the build differentiates (a segment
-// count, a time function's parameter: nullopt, never a derivative silently 0).
+// count, the segmentation target: nullopt, never a derivative silently 0).
 std::optional<DualModel> load_dual_scene(const Json& scene, const Where& where,
                                          const std::map<std::string, double>& seeds,
                                          const std::vector<SegmentChoice>& pinned,

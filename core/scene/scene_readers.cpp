@@ -141,10 +141,13 @@ Mat3T<S> seeded_inertia(const SceneSpecsT<S>& specs, const Mat3& j, const Where&
   return out;
 }
 
-std::optional<TimeFunction> read_time_function(const Json& value, const Where& where,
-                                               Diagnostics& diag) {
+template <class S>
+std::optional<TimeFunctionT<S>> read_time_function(const Json& value, const Where& where,
+                                                   Diagnostics& diag, const SceneSpecsT<S>& specs) {
   ObjectReader r(value, where, diag);
   if (!r.is_object()) return std::nullopt;
+  using TimeFunction = TimeFunctionT<S>;
+  const auto number = [&](const std::string& key, double x) { return seeded(specs, x, r.at(key)); };
   TimeFunction f;
   const auto type = r.choice("type", true, {"constant", "step", "ramp", "harmonic", "table"});
   if (!type) {
@@ -154,7 +157,7 @@ std::optional<TimeFunction> read_time_function(const Json& value, const Where& w
   if (*type == "constant") return f;
   if (*type == "step") {
     f.type = TimeFunction::Type::kStep;
-    f.at = r.number_or("at", 0.0);
+    f.at = number("at", r.number_or("at", 0.0));
     return f;
   }
   if (*type == "ramp") {
@@ -165,15 +168,15 @@ std::optional<TimeFunction> read_time_function(const Json& value, const Where& w
       r.error("to", "must be greater than \"from\"");
       return std::nullopt;
     }
-    f.from = *from, f.to = *to;
+    f.from = number("from", *from), f.to = number("to", *to);
     return f;
   }
   if (*type == "harmonic") {
     f.type = TimeFunction::Type::kHarmonic;
     const auto freq = r.positive("frequency", true);
-    f.phase = r.number_or("phase", 0.0);
+    f.phase = number("phase", r.number_or("phase", 0.0));
     if (!freq) return std::nullopt;
-    f.frequency = *freq;
+    f.frequency = number("frequency", *freq);
     return f;
   }
   f.type = TimeFunction::Type::kTable;
@@ -188,7 +191,10 @@ std::optional<TimeFunction> read_time_function(const Json& value, const Where& w
       diag.error(where.file, (where / "t" / i).pointer, "times must be strictly increasing");
       return std::nullopt;
     }
-  f.t = *t, f.v = *v;
+  for (size_t i = 0; i < t->size(); ++i) {
+    f.t.push_back(seeded(specs, (*t)[i], r.at("t") / i));
+    f.v.push_back(seeded(specs, (*v)[i], r.at("v") / i));
+  }
   return f;
 }
 
@@ -494,8 +500,9 @@ void read_loads(ObjectReader& scene, SceneSpecsT<S>& specs) {
     const bool follows_bad = !follows && v.contains("follows");  // reported by r.boolean
     if (load_case && load_case->empty())
       r.error("case", "must not be empty (omit it for a load of every analysis)");
-    std::optional<TimeFunction> time = TimeFunction{};
-    if (const Json* t = r.member("time", false)) time = read_time_function(*t, at / "time", diag);
+    std::optional<TimeFunctionT<S>> time = TimeFunctionT<S>{};
+    if (const Json* t = r.member("time", false))
+      time = read_time_function(*t, at / "time", diag, specs);
     if (body && specs.bodies[*body].fixed) {
       r.error("body",
               "body \"" + specs.bodies[*body].name + "\" is fixed: a load on it does nothing");

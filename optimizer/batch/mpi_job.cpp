@@ -166,20 +166,11 @@ class MpiExecutor : public BatchExecutor {
       ++stats_.designs_per_rank[rank];
       if (!done(i, o)) stopped = true;
     };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads_; ++t)
-      pool.emplace_back([&] {
-        for (long i = take(); i >= 0; i = take())
-          deliver(0, i, evaluate_design(evaluator, designs[i]));
-      });
-
     std::vector<int> ahead(size, 0);
     long pending = 0;  // designs sent and not back yet
     bool exhausted = false;
-    Backoff backoff(std::chrono::microseconds(1000));
-    while (true) {
-      const double busy = thread_cpu_seconds();
-      const long pending_before = pending;
+    // Tops up every other rank's window of designs ahead.
+    const auto fill = [&] {
       for (int r = 1; r < size && !exhausted; ++r)
         while (ahead[r] < threads_ + 1) {
           const long i = take();
@@ -194,6 +185,24 @@ class MpiExecutor : public BatchExecutor {
           ++ahead[r];
           ++pending;
         }
+    };
+    // The other ranks' first designs go out before rank 0's own threads start taking designs: a
+    // batch of quick designs is not all done on rank 0 while the others wait for work.
+    const double first = thread_cpu_seconds();
+    fill();
+    scheduling += thread_cpu_seconds() - first;
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads_; ++t)
+      pool.emplace_back([&] {
+        for (long i = take(); i >= 0; i = take())
+          deliver(0, i, evaluate_design(evaluator, designs[i]));
+      });
+
+    Backoff backoff(std::chrono::microseconds(1000));
+    while (true) {
+      const double busy = thread_cpu_seconds();
+      const long pending_before = pending;
+      fill();
       int found = 0;
       MPI_Status probed;
       MPI_Iprobe(MPI_ANY_SOURCE, kTagResult, MPI_COMM_WORLD, &found, &probed);

@@ -4,7 +4,7 @@
 // variable, the design's model along it: the scene built on hyper-dual numbers with the variable's
 // numbers seeded (load_dual_scene: forward-mode automatic differentiation through the scene ->
 // model build). No analysis is run again. A variable that addresses more than the inline scene, or
-// a number the build does not differentiate (a segment count, a time function's parameter), has
+// a number the build does not differentiate (a segment count, the segmentation target), has
 // no exact derivative: the study says so (gradient algorithms then take "gradient": "fd").
 #pragma once
 

@@ -299,6 +299,30 @@ TEST(Sensitivities, ResponsesWithoutExactDerivativesSaySo) {
 // (the full tangent, its non-symmetric load stiffness included), against extrapolated central
 // differences of whole evaluations; the frequencies about that equilibrium (a non-symmetric
 // eigenproblem) have none, and say so.
+// A load's time function is part of the scene: the tip load ramps from 0 at t = 0 to 3 N at
+// t = to = 2 s, the static analysis reads it at t = 1 s (factor t / to): d dy/d to = -dy / to.
+TEST(Sensitivities, ATimeFunctionsParametersAreDesignNumbers) {
+  Diagnostics diag;
+  auto document = parse_json(kCantilever, "sensitivities.json", diag);
+  ASSERT_TRUE(document) << diag.format();
+  (*document)["scene"]["loads"][0]["time"] = Json{{"type", "ramp"}, {"from", 0}, {"to", 2.0}};
+  (*document)["analyses"][0]["time"] = 1.0;
+  (*document)["study"]["variables"] = Json::parse(
+      R"([{"name": "to", "pointer": "/scene/loads/0/time/to"},
+          {"name": "F", "pointer": "/scene/loads/0/value/1", "factors": [-1]}])");
+  const auto study = load_study(*document, "sensitivities.json", ".", diag);
+  ASSERT_TRUE(study) << diag.format();
+  const DesignEvaluator evaluator(*study);
+  const Result r = at(evaluator, {2.0, 3.0});
+  const double dy = r.outcome.responses[0];
+  std::printf("ramp: dy %.10e, d dy/d to %.10e (-dy/to %.10e), d dy/dF %.10e (dy/F %.10e)\n", dy,
+              r.s.jacobian(0, 0), -dy / 2.0, r.s.jacobian(0, 1), dy / 3.0);
+  // dy is F(t) L^3 / (3 E I) to ~1e-6 (the nonlinearity); its derivatives with respect to the
+  // ramp's end and to the load are the same function of F(t) = F t / to, so their ratio is exact.
+  EXPECT_NEAR(r.s.jacobian(0, 0) / r.s.jacobian(0, 1), -3.0 / 2.0, 1e-12);
+  EXPECT_NEAR(r.s.jacobian(0, 0) / (-dy / 2.0), 1.0, 1e-5);
+}
+
 // The derivatives follow the scene's numbers through its build: a variable on an analysis's option
 // or on a number the build does not differentiate (a segment count) has none, and says so rather
 // than giving 0.

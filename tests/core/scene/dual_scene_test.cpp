@@ -2,10 +2,10 @@
 // automatic differentiation through the scene -> model build. On a scene with every kind of number
 // a design variable may address (section dimensions of every shape and custom constants, material
 // constants, body mass, inertia, position and orientation, attachment points, damping, a rail's
-// floor and travel, load values and points, a follower load, gravity, a joint's point, axis and
-// compliance, segmented beams), the values are the double build's and the derivatives of every
-// number of the model agree with extrapolated central differences of double builds; a pointer to
-// a number the build does not differentiate is refused.
+// floor and travel, load values and points, a follower load, load time functions, gravity, a
+// joint's point, axis and compliance, segmented beams), the values are the double build's and the
+// derivatives of every number of the model agree with extrapolated central differences of double
+// builds; a pointer to a number the build does not differentiate is refused.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -57,8 +57,10 @@ const char* kScene = R"json({
     {"name": "pin", "type": "revolute", "body1": "hub", "body2": "cart", "point": [0.5, 0.1, 1.3],
      "axis": [0.2, 1, 0.1], "relative_compliance": 1e-5}],
   "loads": [
-    {"type": "force", "body": "tip", "value": [10, -20, 30], "point": [1.25, 0.3, 0.95]},
-    {"type": "torque", "body": "hub", "value": [1, 2, -3], "follows": true}]})json";
+    {"type": "force", "body": "tip", "value": [10, -20, 30], "point": [1.25, 0.3, 0.95],
+     "time": {"type": "table", "t": [0, 1, 2], "v": [0, 1, 0.5]}},
+    {"type": "torque", "body": "hub", "value": [1, 2, -3], "follows": true,
+     "time": {"type": "harmonic", "frequency": 3, "phase": 0.2}}]})json";
 
 // The study variables' kinds: one pointer per kind.
 const std::vector<std::string> kPointers = {
@@ -90,6 +92,9 @@ const std::vector<std::string> kPointers = {
     "/scene/loads/0/value/1",
     "/scene/loads/0/point/2",
     "/scene/loads/1/value/0",
+    "/scene/loads/0/time/t/1",
+    "/scene/loads/0/time/v/2",
+    "/scene/loads/1/time/frequency",
 };
 
 Json scene_json() { return Json::parse(kScene); }

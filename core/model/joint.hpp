@@ -56,7 +56,7 @@ std::pair<S, S> joint_stiffness_scale(const ModelT<S>& model) {
     if (x > to) to = x;
   };
   const auto element = [&](const S& ea, const S& gj, const S& eiy, const S& eiz, const S& l) {
-    const S ei = eiy > eiz ? eiy : eiz;
+    const S ei = eiy < eiz ? eiz : eiy;  // as std::max: eiy on a tie
     raise(kt, ea / l);
     raise(kt, 12.0 * ei / (l * l * l));
     raise(kr, gj / l);

@@ -19,7 +19,10 @@ S rectangle_torsion_constant(S a, S b) {
   S tail = 0.0;
   for (int n = 1; n < 60; n += 2) {
     const S x = n * pi * a / (2.0 * b);
-    const S term = 2.0 / (exp(2.0 * x) + 1.0) / std::pow(n, 5);  // 1 - tanh(x)
+    // 1 - tanh(x) = 2 e^-2x / (1 + e^-2x): no overflow for a thin strip (x > 355), whose
+    // exp(2x) would be infinite (harmless for doubles, NaN derivatives for dual numbers).
+    const S e = exp(-2.0 * x);
+    const S term = 2.0 * e / (1.0 + e) / std::pow(n, 5);
     tail += term;
     if (term < 1e-20) break;
   }

@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/batch/nlopt_setup.hpp"
+#include "optimizer/study/nlopt_setup.hpp"
 
 namespace beamrail {
 

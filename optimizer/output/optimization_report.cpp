@@ -7,12 +7,12 @@
 #include <iostream>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/batch/nlopt_setup.hpp"
 #include "optimizer/cli/interruption.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
 #include "optimizer/run/status.hpp"
+#include "optimizer/study/nlopt_setup.hpp"
 
 namespace beamrail {
 

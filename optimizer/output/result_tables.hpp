@@ -12,6 +12,7 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/transient.hpp"
 #include "optimizer/output/tables.hpp"
+#include "optimizer/run/result_tables.hpp"
 #include "optimizer/run/transient_sink.hpp"
 
 namespace beamrail {
@@ -54,35 +55,6 @@ class TimeseriesFiles : public TransientSink {
   std::filesystem::path directory_;
   std::optional<TimeseriesWriter> writer_;
 };
-
-// A table of one analysis as data: its file name (with the analysis's prefix), header and rows
-// of formatted fields. An evaluation keeps those of its static, modal and buckling analyses
-// (EvaluationOptions::result_tables); write_result_tables() files them.
-struct ResultTable {
-  std::string file;
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-};
-
-// The tables of one analysis, their file names preceded by `prefix` ("" for an analysis named
-// after its type, else "<name>.").
-
-// static_displacements.csv (free bodies: dx, dy, dz and rotation vector rx, ry, rz) and
-// element_forces.csv (end forces of every beam and rail, element axes).
-std::vector<ResultTable> static_tables(const std::string& prefix, const Model& model,
-                                       const Data& data);
-
-// modes.csv (mode, frequency_hz, kind; rigid-body modes first with mode 0; the dominant direction,
-// then per direction x .. rz the participation, effective mass and its fraction of the total, see
-// Mode::participation) and mode_shapes.csv (elastic modes, M-normalized, per free body).
-std::vector<ResultTable> modal_tables(const std::string& prefix, const Model& model,
-                                      const ModalResult& result);
-
-// buckling.csv (mode, factor, nonlinearity: BucklingMode::nonlinearity) and buckling_shapes.csv
-// (mode, body, dx .. rz: the shape with its largest translation, or rotation times the
-// characteristic length, 1).
-std::vector<ResultTable> buckling_tables(const std::string& prefix, const Model& model,
-                                         const BucklingResult& result);
 
 // Writes the tables to `directory`, each replacing the previous one whole (written beside it and
 // renamed). Stops at the first error, false with *error naming the file.

@@ -7,10 +7,9 @@
 #include <string>
 #include <vector>
 
-namespace beamrail {
+#include "optimizer/run/number_text.hpp"
 
-// Shortest text that reads back as exactly x ("nan", "inf", "-inf" for non-finite values).
-std::string format_number(double x);
+namespace beamrail {
 
 // Writes all of text to the file descriptor, retrying short and interrupted writes; false on an
 // error (errno says which).

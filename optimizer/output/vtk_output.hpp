@@ -50,6 +50,7 @@
 #include "core/analysis/transient.hpp"
 #include "core/model/data.hpp"
 #include "core/model/model.hpp"
+#include "optimizer/run/drawing_sink.hpp"
 
 namespace beamrail {
 
@@ -63,29 +64,29 @@ class SceneDrawing;
 // The VTK files of one evaluation, into `directory` (<results>/vtk). Each analysis replaces its
 // own files (<analysis>.pvd and the folder <analysis>/) and leaves the others'. Not thread-safe:
 // one per evaluation.
-class VtkOutput {
+class VtkOutput : public DrawingSink {
  public:
   explicit VtkOutput(std::filesystem::path directory);
-  ~VtkOutput();
+  ~VtkOutput() override;
   VtkOutput(const VtkOutput&) = delete;
   VtkOutput& operator=(const VtkOutput&) = delete;
 
   // The undeformed scene and the equilibrium in `deformed`.
   bool write_static(const std::string& analysis, const Model& model, const Data& deformed,
-                    std::string* error);
+                    std::string* error) override;
   // The elastic modes of `result` about the state in `about`.
   bool write_modes(const std::string& analysis, const Model& model, const Data& about,
-                   const ModalResult& result, std::string* error);
+                   const ModalResult& result, std::string* error) override;
   // The buckling shapes of `result` about the reference state in `about`.
   bool write_buckling(const std::string& analysis, const Model& model, const Data& about,
-                      const BucklingResult& result, std::string* error);
+                      const BucklingResult& result, std::string* error) override;
 
   // A transient: begin_series, then frame() per output row (it throws std::runtime_error naming
   // the file and the reason when a frame cannot be written), then end_series(), also after a
   // failed run (the collection holds the frames written).
-  bool begin_series(const std::string& analysis, const Model& model, std::string* error);
-  void frame(double t, const Data& data);
-  bool end_series(std::string* error);
+  bool begin_series(const std::string& analysis, const Model& model, std::string* error) override;
+  void frame(double t, const Data& data) override;
+  bool end_series(std::string* error) override;
 
   // Writes contents.json: what each analysis wrote, and `design` (the design drawn, for a design
   // study; null for a single run).

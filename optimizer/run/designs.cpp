@@ -6,8 +6,8 @@
 #include <optional>
 
 #include "core/scene/scene_loader.hpp"
-#include "optimizer/output/tables.hpp"
 #include "optimizer/run/evaluation.hpp"
+#include "optimizer/run/number_text.hpp"
 
 namespace beamrail {
 
@@ -83,9 +83,13 @@ ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& 
     for (size_t k = 0; k < pointers_[j].size(); ++k)
       seeds[pointers_[j][k].to_string()] += variables[j].factors[k];
     Diagnostics diag;
-    directions[j] =
-        load_dual_scene(doc.at("scene"), scene, seeds, design.model.segment_choices, diag);
-    if (!directions[j]) refused[j] = problems(diag);
+    try {  // nothing may leave the parallel region
+      directions[j] =
+          load_dual_scene(doc.at("scene"), scene, seeds, design.model.segment_choices, diag);
+      if (!directions[j]) refused[j] = problems(diag);
+    } catch (const std::exception& e) {
+      refused[j] = std::string("the scene's build on dual numbers failed: ") + e.what();
+    }
   }
   std::vector<DualModel> along;
   for (int j = 0; j < nv; ++j) {

@@ -8,9 +8,8 @@
 #include <memory>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/output/tables.hpp"
-#include "optimizer/output/vtk_output.hpp"
 #include "optimizer/run/expressions.hpp"
+#include "optimizer/run/number_text.hpp"
 #include "optimizer/run/responses.hpp"
 #include "optimizer/run/trajectory.hpp"
 

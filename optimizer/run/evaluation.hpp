@@ -13,15 +13,14 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
-#include "optimizer/output/result_tables.hpp"
+#include "optimizer/run/drawing_sink.hpp"
 #include "optimizer/run/responses.hpp"
+#include "optimizer/run/result_tables.hpp"
 #include "optimizer/run/status.hpp"
 #include "optimizer/run/transient_sink.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
-
-class VtkOutput;
 
 // A transient rerun at tolerances ten times tighter: the error the run achieved beside its cost.
 struct Verification {
@@ -156,8 +155,9 @@ struct EvaluationOptions {
   const ModeShapes* mode_references = nullptr;
   // Keep the states the analyses reported about (Evaluation::states), for design sensitivities.
   bool keep_states = false;
-  // Where the analyses draw their VTK files (optimizer/output/vtk_output.hpp); nullptr: none.
-  VtkOutput* vtk = nullptr;
+  // Where the analyses hand their drawings (optimizer/output/vtk_output.hpp files them as VTK);
+  // nullptr: none.
+  DrawingSink* vtk = nullptr;
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed

@@ -9,7 +9,7 @@
 #include <map>
 #include <mutex>
 
-#include "optimizer/output/tables.hpp"
+#include "optimizer/run/number_text.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {

@@ -1,5 +1,6 @@
 #include "optimizer/run/sensitivities.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -8,6 +9,7 @@
 
 #include "core/analysis/sensitivity.hpp"
 #include "optimizer/run/expressions.hpp"
+#include "optimizer/run/number_text.hpp"
 #include "optimizer/run/responses.hpp"
 
 namespace beamrail {
@@ -21,6 +23,22 @@ bool same_topology(const ModelT<A>& a, const ModelT<B>& b) {
          a.beams.size() == b.beams.size() && a.rails.size() == b.rails.size() &&
          a.joints.size() == b.joints.size() && a.loads.size() == b.loads.size() &&
          a.free_bodies == b.free_bodies;
+}
+
+// Whether the design direction moves a breakpoint of a load's time function (a step's time, a
+// ramp's ends, a table's times) that lies at time t: the load factor has a kink or a jump there,
+// and its derivative with respect to that parameter is one-sided.
+bool moves_breakpoint_at(const DualModel& direction, double t) {
+  const auto here = [t](const HyperDual& x) { return x.b != 0.0 && x.v == t; };
+  for (const LoadT<HyperDual>& load : direction.loads) {
+    const TimeFunctionT<HyperDual>& f = load.time;
+    using Type = TimeFunctionT<HyperDual>::Type;
+    if ((f.type == Type::kStep && here(f.at)) ||
+        (f.type == Type::kRamp && (here(f.from) || here(f.to))) ||
+        (f.type == Type::kTable && std::any_of(f.t.begin(), f.t.end(), here)))
+      return true;
+  }
+  return false;
 }
 
 class Sensitivities {
@@ -81,7 +99,12 @@ ResponseSensitivities Sensitivities::run(const std::vector<DualModel>& direction
 #pragma omp parallel for schedule(dynamic, 1) if (nv > 1)
   for (int j = 0; j < nv; ++j) {
     per[j].jacobian = Eigen::MatrixXd::Constant(nr, 1, kNaN);
-    done[j] = variable(j, directions[j], per[j]);
+    try {  // nothing may leave the parallel region
+      done[j] = variable(j, directions[j], per[j]);
+    } catch (const std::exception& e) {
+      per[j].message = std::string("the sensitivities failed: ") + e.what();
+      done[j] = 0;
+    }
   }
   for (int j = 0; j < nv; ++j) {
     if (!done[j]) {
@@ -93,8 +116,21 @@ ResponseSensitivities Sensitivities::run(const std::vector<DualModel>& direction
     for (std::string& w : per[j].warnings) out.warnings.push_back(std::move(w));
   }
   chain_expression_derivatives(design_, ev_.responses, out.jacobian);
-  for (int k = 0; k < nr; ++k)
-    if (std::isnan(ev_.responses[k])) out.jacobian.row(k).setConstant(kNaN);
+  for (int k = 0; k < nr; ++k) {
+    if (std::isnan(ev_.responses[k])) {
+      out.jacobian.row(k).setConstant(kNaN);
+      continue;
+    }
+    // A finite response with a derivative that is not: never handed on as a gradient.
+    for (int j = 0; j < nv; ++j)
+      if (!std::isfinite(out.jacobian(k, j))) {
+        out.message = "the derivative of response \"" + design_.responses[k].name +
+                      "\" with respect to variable " + std::to_string(j + 1) + " is not finite (" +
+                      format_number(out.jacobian(k, j)) + ")";
+        out.jacobian.setConstant(kNaN);
+        return out;
+      }
+  }
   out.ok = true;
   return out;
 }
@@ -143,6 +179,12 @@ bool Sensitivities::variable(int j, const DualModel& direction, ResponseSensitiv
     if (!reads) continue;
     const Eigen::VectorXd* dv = state_derivative(a.equilibrium);
     if (!a.equilibrium.empty() && !dv) return false;
+    if (spec.type != AnalysisSpec::Type::kTransient && std::isfinite(a.time) &&
+        moves_breakpoint_at(models_of(spec.load_case), a.time))
+      out.warnings.push_back("analysis \"" + spec.name + "\" reads the loads at t = " +
+                             format_number(a.time) + ", where variable " + std::to_string(j + 1) +
+                             " moves a breakpoint of a load's time function: its derivatives "
+                             "there are one-sided (the load factor has a kink or a jump)");
     const Eigen::VectorXd none;
     const Eigen::VectorXd& du = dv ? *dv : none;
     switch (spec.type) {

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <set>
 
-#include "optimizer/batch/nlopt_setup.hpp"
 #include "optimizer/study/design_study.hpp"
+#include "optimizer/study/nlopt_setup.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {

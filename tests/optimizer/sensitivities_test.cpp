@@ -323,6 +323,36 @@ TEST(Sensitivities, ATimeFunctionsParametersAreDesignNumbers) {
   EXPECT_NEAR(r.s.jacobian(0, 0) / (-dy / 2.0), 1.0, 1e-5);
 }
 
+// A thin strip (width / height 250: the torsion series' exp(2 x) overflows a double) keeps finite
+// derivatives; and a static analysis read at the ramp's end says its derivative with respect to
+// that end is one-sided.
+TEST(Sensitivities, AThinStripAndARampsEndKeepFiniteOrFlaggedDerivatives) {
+  Diagnostics diag;
+  auto document = parse_json(kCantilever, "sensitivities.json", diag);
+  ASSERT_TRUE(document) << diag.format();
+  (*document)["scene"]["sections"]["r"] =
+      Json{{"shape", "rectangle"}, {"width", 0.05}, {"height", 0.0002}};
+  (*document)["scene"]["loads"][0]["time"] = Json{{"type", "ramp"}, {"from", 0}, {"to", 2.0}};
+  (*document)["scene"]["loads"][0]["value"][1] = -1e-6;
+  (*document)["analyses"][0]["time"] = 2.0;
+  (*document)["study"]["variables"] = Json::parse(
+      R"([{"name": "to", "pointer": "/scene/loads/0/time/to"},
+          {"name": "h", "pointer": "/scene/sections/r/height"}])");
+  const auto study = load_study(*document, "sensitivities.json", ".", diag);
+  ASSERT_TRUE(study) << diag.format();
+  const DesignEvaluator evaluator(*study);
+  const Result r = at(evaluator, {2.0, 0.0002});
+  ASSERT_TRUE(r.s.ok) << r.s.message;
+  EXPECT_TRUE(r.s.jacobian.allFinite()) << r.s.jacobian;
+  // The frequencies grow with the strip's height (bending about its thin axis: EI ~ h^3).
+  EXPECT_GT(r.s.jacobian(1, 1), 0.0);
+  bool flagged = false;
+  for (const std::string& w : r.s.warnings)
+    flagged =
+        flagged || w.find("moves a breakpoint of a load's time function") != std::string::npos;
+  EXPECT_TRUE(flagged);
+}
+
 // The derivatives follow the scene's numbers through its build: a variable on an analysis's option
 // or on a number the build does not differentiate (a segment count) has none, and says so rather
 // than giving 0.

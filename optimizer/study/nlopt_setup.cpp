@@ -1,4 +1,4 @@
-#include "optimizer/batch/nlopt_setup.hpp"
+#include "optimizer/study/nlopt_setup.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "core/model/derivative_scalar.hpp"
+
 namespace beamrail {
 
 #define BEAMRAIL_DUAL_INLINE inline __attribute__((always_inline))
@@ -182,21 +184,7 @@ BEAMRAIL_DUAL_INLINE Dual<N> atan2(const Dual<N>& y, const Dual<N>& x) {
 
 namespace Eigen {
 template <int N>
-struct NumTraits<beamrail::Dual<N>> : NumTraits<double> {
-  using Real = beamrail::Dual<N>;
-  using NonInteger = beamrail::Dual<N>;
-  using Nested = beamrail::Dual<N>;
-  using Literal = beamrail::Dual<N>;
-  enum {
-    IsComplex = 0,
-    IsInteger = 0,
-    IsSigned = 1,
-    RequireInitialization = 1,
-    ReadCost = 1,
-    AddCost = 2,
-    MulCost = 4
-  };
-};
+struct NumTraits<beamrail::Dual<N>> : beamrail::DerivativeScalarTraits<beamrail::Dual<N>, 2, 4> {};
 template <int N, typename BinaryOp>
 struct ScalarBinaryOpTraits<beamrail::Dual<N>, double, BinaryOp> {
   using ReturnType = beamrail::Dual<N>;

@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "core/model/derivative_scalar.hpp"
+
 namespace beamrail {
 
 struct HyperDual {
@@ -114,21 +116,8 @@ inline HyperDual atan2(const HyperDual& y, const HyperDual& x) {
 
 namespace Eigen {
 template <>
-struct NumTraits<beamrail::HyperDual> : NumTraits<double> {
-  using Real = beamrail::HyperDual;
-  using NonInteger = beamrail::HyperDual;
-  using Nested = beamrail::HyperDual;
-  using Literal = beamrail::HyperDual;
-  enum {
-    IsComplex = 0,
-    IsInteger = 0,
-    IsSigned = 1,
-    RequireInitialization = 1,
-    ReadCost = 1,
-    AddCost = 4,
-    MulCost = 9
-  };
-};
+struct NumTraits<beamrail::HyperDual>
+    : beamrail::DerivativeScalarTraits<beamrail::HyperDual, 4, 9> {};
 template <typename BinaryOp>
 struct ScalarBinaryOpTraits<beamrail::HyperDual, double, BinaryOp> {
   using ReturnType = beamrail::HyperDual;

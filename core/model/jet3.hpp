@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "core/model/derivative_scalar.hpp"
+
 namespace beamrail {
 
 struct Jet3 {
@@ -130,21 +132,7 @@ inline Jet3 atan2(const Jet3& y, const Jet3& x) {
 
 namespace Eigen {
 template <>
-struct NumTraits<beamrail::Jet3> : NumTraits<double> {
-  using Real = beamrail::Jet3;
-  using NonInteger = beamrail::Jet3;
-  using Nested = beamrail::Jet3;
-  using Literal = beamrail::Jet3;
-  enum {
-    IsComplex = 0,
-    IsInteger = 0,
-    IsSigned = 1,
-    RequireInitialization = 1,
-    ReadCost = 1,
-    AddCost = 8,
-    MulCost = 27
-  };
-};
+struct NumTraits<beamrail::Jet3> : beamrail::DerivativeScalarTraits<beamrail::Jet3, 8, 27> {};
 template <typename BinaryOp>
 struct ScalarBinaryOpTraits<beamrail::Jet3, double, BinaryOp> {
   using ReturnType = beamrail::Jet3;

@@ -28,12 +28,6 @@ StopOnSignals::~StopOnSignals() {
   sigaction(SIGTERM, &previous_term, nullptr);
 }
 
-std::string signal_name(int signal) {
-  if (signal == SIGINT) return "SIGINT";
-  if (signal == SIGTERM) return "SIGTERM";
-  return "signal " + std::to_string(signal);
-}
-
 int interrupted_exit_status(int signal) { return 128 + signal; }
 
 }  // namespace beamrail

@@ -5,8 +5,6 @@
 // signal ends the process at once, as without this handling.
 #pragma once
 
-#include <string>
-
 namespace beamrail {
 
 class StopOnSignals {
@@ -16,9 +14,6 @@ class StopOnSignals {
   StopOnSignals(const StopOnSignals&) = delete;
   StopOnSignals& operator=(const StopOnSignals&) = delete;
 };
-
-// "SIGINT", "SIGTERM" (or "signal N").
-std::string signal_name(int signal);
 
 // The exit status of a run stopped by `signal`: 128 + signal.
 int interrupted_exit_status(int signal);

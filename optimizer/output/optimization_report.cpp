@@ -246,20 +246,21 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
                        cost.fallback_reason);
   for (const std::string& w : cost.sensitivity_warnings) warnings.push_back("derivatives: " + w);
   const bool interrupted = signal != 0 && stopped;
-  std::string status, message;
+  RunStatus status = RunStatus::kOk;
+  std::string message;
   if (!history_error.empty()) {
-    status = status_name(Status::kFailed), message = history_error;
+    status = RunStatus::kFailed, message = history_error;
   } else if (!errors.empty()) {
-    status = status_name(Status::kFailed);
+    status = RunStatus::kFailed;
     for (const std::string& e : errors) message += (message.empty() ? "" : "; ") + e;
   } else if (interrupted) {
-    status = status_name(Status::kInterrupted);
+    status = RunStatus::kInterrupted;
     message = "interrupted by " + signal_name(signal) + " after " +
               std::to_string(records_.size()) + " designs";
   } else if (best) {
-    status = status_name(Status::kOk);
+    status = RunStatus::kOk;
   } else {
-    status = "infeasible";
+    status = RunStatus::kInfeasible;
     message = "no evaluated design satisfies every constraint";
     long warned = 0;
     for (const OptimizationRecord& r : records_)
@@ -277,7 +278,7 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
   s["type"] = "optimize";
   s["algorithm"] = plan_.algorithm;
   s["optimizer"] = NloptSetup(plan_, variables_).description();
-  s["status"] = status;
+  s["status"] = run_status_name(status);
   s["message"] = message;
   s["warnings"] = warnings;
   s["max_evaluations"] = plan_.max_evaluations;
@@ -340,8 +341,7 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
   long warned = 0;
   for (const OptimizationRecord& r : records_) warned += r.outcome.warnings > 0;
   s["designs_with_warnings"] = warned;
-  s["warned_designs"] =
-      plan_.warned_designs == OptimizePlan::WarnedDesigns::kAccept ? "accept" : "infeasible";
+  s["warned_designs"] = warned_designs_name(plan_.warned_designs);
   s["designs_in_history"] = records_.size();
   s["ranks"] = run.ranks;
   s["threads"] = run.threads;
@@ -368,7 +368,7 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
     b["responses"] = resp;
     b["constraints"] = constraint_report(problem, best->outcome);
     b["active_tolerance"] = problem.active_tolerance();
-    if (status == status_name(Status::kOk)) {
+    if (status == RunStatus::kOk) {
       s["best"] = b;
       s["responses"] = resp;
       Json scene = evaluator.document(best->x);
@@ -393,12 +393,12 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
     return 1;
   }
   const std::string history = (settings_.output / "history.csv").string();
-  if (status == status_name(Status::kFailed)) {
+  if (status == RunStatus::kFailed) {
     std::cerr << "beamrail: " << study_.name << " failed: " << message << "\n(" << records_.size()
               << " designs evaluated are in " << history << "; no best.json is written)\n";
     return 1;
   }
-  if (status == status_name(Status::kInterrupted)) {
+  if (status == RunStatus::kInterrupted) {
     std::cerr << "beamrail: " << study_.name << " interrupted by " << signal_name(signal) << ": "
               << records_.size() << " designs are in " << history
               << "; continue with: " << settings_.command << " --resume\n";

@@ -12,6 +12,7 @@
 
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
+#include "optimizer/run/status.hpp"
 
 namespace beamrail {
 namespace {
@@ -105,7 +106,7 @@ bool OutputFolder::start(const Study& study, std::string* error) const {
         break;
     }
   }
-  running["status"] = "running";
+  running["status"] = run_status_name(RunStatus::kRunning);
   running["message"] =
       "a run started writing this folder and has not finished (it is running, or it was killed): "
       "the tables may be incomplete";

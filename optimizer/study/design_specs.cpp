@@ -282,9 +282,12 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
   p.gradient_step = r.positive("gradient_step", false).value_or(p.gradient_step);
   if (const auto g = r.choice("gradient", false, {"exact", "fd"}))
     p.gradient = *g == "fd" ? OptimizePlan::Gradient::kDifferences : OptimizePlan::Gradient::kExact;
-  if (const auto w = r.choice("warned_designs", false, {"infeasible", "accept"}))
-    p.warned_designs = *w == "accept" ? OptimizePlan::WarnedDesigns::kAccept
-                                      : OptimizePlan::WarnedDesigns::kInfeasible;
+  using Warned = OptimizePlan::WarnedDesigns;
+  if (const auto w = r.choice("warned_designs", false,
+                              {warned_designs_name(Warned::kInfeasible),
+                               warned_designs_name(Warned::kAccept)}))
+    p.warned_designs =
+        *w == warned_designs_name(Warned::kAccept) ? Warned::kAccept : Warned::kInfeasible;
 }
 
 void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {

@@ -69,6 +69,12 @@ struct OptimizePlan {
   WarnedDesigns warned_designs = WarnedDesigns::kInfeasible;
 };
 
+// The name of a "warned_designs" choice in the study file and summary.json: "infeasible",
+// "accept".
+inline const char* warned_designs_name(OptimizePlan::WarnedDesigns choice) {
+  return choice == OptimizePlan::WarnedDesigns::kAccept ? "accept" : "infeasible";
+}
+
 // The measured speed-accuracy trade of the study's transient analysis: every method at every
 // tolerance against a tight reference run.
 struct WorkPrecisionPlan {

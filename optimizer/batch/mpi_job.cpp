@@ -38,7 +38,7 @@ MpiJob* mpi_job() { return current_job; }
 bool mpi_available() { return false; }
 MpiJob::MpiJob(int*, char***) { current_job = this; }
 MpiJob::~MpiJob() { current_job = nullptr; }
-int MpiJob::serve() { return 0; }
+void MpiJob::serve() {}
 std::unique_ptr<BatchExecutor> MpiJob::executor(int threads) {
   return std::make_unique<ThreadExecutor>(threads);
 }
@@ -338,7 +338,7 @@ std::vector<bool> MpiJob::run_tasks(const Study& study, int threads, TaskKind ki
   return std::vector<bool>(ran.begin(), ran.end());
 }
 
-int MpiJob::serve() {
+void MpiJob::serve() {
   std::unique_ptr<Study> study;
   std::unique_ptr<DesignEvaluator> evaluator;
   std::string unusable;  // why the study sent could not be loaded (then every design fails)
@@ -453,7 +453,6 @@ int MpiJob::serve() {
   }
   for (std::thread& t : pool) t.join();
   if (task.joinable()) task.join();
-  return 0;
 }
 
 #endif

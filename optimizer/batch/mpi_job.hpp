@@ -54,9 +54,10 @@ class MpiJob {
   int rank() const { return rank_; }
   int size() const { return size_; }
 
-  // Ranks other than 0: evaluates what rank 0 sends until it says stop. Returns the exit status:
-  // 0 (a design that fails is an outcome sent back, not an error of the rank).
-  int serve();
+  // Ranks other than 0: evaluates what rank 0 sends until it says stop. A design that fails is
+  // an outcome sent back, not an error of the rank: the rank's process ends with status 0
+  // (cli/main.cpp).
+  void serve();
 
   // Rank 0: an executor over every rank of the job, each evaluating `threads` designs at once.
   std::unique_ptr<BatchExecutor> executor(int threads);

@@ -13,8 +13,6 @@
 #include "optimizer/batch/mpi_job.hpp"
 #include "optimizer/batch/progress.hpp"
 #include "optimizer/batch/start_task.hpp"
-#include "optimizer/output/optimization_report.hpp"
-#include "optimizer/output/summary.hpp"
 
 namespace beamrail {
 namespace {
@@ -232,19 +230,6 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
   run.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return run;
-}
-
-int run_optimize(const Study& study, const RunSettings& settings) {
-  const OptimizationProblem problem(study);
-  const DesignEvaluator evaluator(study);
-  if (!evaluator.setup_failure().empty())
-    return fail_before_designs(study, settings.output, "optimize", evaluator.setup_failure());
-  OptimizationFiles files(problem, settings);
-  if (const int status = files.open()) return status;
-  const OptimizationRun run =
-      optimize(problem, evaluator, settings, files.resumed(), files.resumed_derivatives(), files);
-  const bool written = files.finalize();
-  return report_optimization(problem, evaluator, settings, run, written ? "" : files.error());
 }
 
 }  // namespace beamrail

@@ -6,7 +6,8 @@
 // that doubles as a cache so that an interrupted run resumes by replaying its evaluations.
 //
 // optimize() computes and hands every row to a sink; output/optimization_report.hpp writes the
-// tables, best.json and summary.json; run_optimize() joins the two.
+// tables, best.json and summary.json; cli/batch_commands.hpp joins the two, prints and returns
+// the exit status.
 #pragma once
 
 #include <utility>
@@ -48,9 +49,5 @@ OptimizationRun optimize(const OptimizationProblem& problem, const DesignEvaluat
                          const RunSettings& settings, const std::vector<ResumedRow>& resumed,
                          const std::vector<std::pair<Design, Eigen::MatrixXd>>& derivatives,
                          StartSink& out);
-
-// Runs the optimization of study.design; writes history.csv, best.json, best_scene.json and
-// summary.json. Returns the exit status (1 when no feasible design was found).
-int run_optimize(const Study& study, const RunSettings& settings);
 
 }  // namespace beamrail

@@ -7,8 +7,6 @@
 #include <memory>
 
 #include "optimizer/batch/executor.hpp"
-#include "optimizer/output/sensitivity_report.hpp"
-#include "optimizer/output/summary.hpp"
 
 namespace beamrail {
 namespace {
@@ -70,15 +68,6 @@ SensitivityResult compute_sensitivities(const Study& study, const DesignEvaluato
   }
   r.check_seconds = seconds_since(check_start);
   return r;
-}
-
-int run_sensitivity(const Study& study, const RunSettings& settings) {
-  const auto start = std::chrono::steady_clock::now();
-  const DesignEvaluator evaluator(study);
-  if (!evaluator.setup_failure().empty())
-    return fail_before_designs(study, settings.output, "sensitivity", evaluator.setup_failure());
-  const SensitivityResult result = compute_sensitivities(study, evaluator, settings);
-  return report_sensitivity(study, settings, result, start);
 }
 
 }  // namespace beamrail

@@ -4,7 +4,7 @@
 // the relative difference of the two).
 //
 // compute_sensitivities() computes; output/sensitivity_report.hpp writes the table and
-// summary.json; run_sensitivity() joins the two.
+// summary.json; cli/batch_commands.hpp joins the two, prints and returns the exit status.
 #pragma once
 
 #include <string>
@@ -34,9 +34,5 @@ struct SensitivityResult {
 // executor: under mpirun, spread over the ranks).
 SensitivityResult compute_sensitivities(const Study& study, const DesignEvaluator& evaluator,
                                         const RunSettings& settings);
-
-// Runs the sensitivity study of study.design; writes sensitivities.csv and summary.json. Returns
-// the exit status.
-int run_sensitivity(const Study& study, const RunSettings& settings);
 
 }  // namespace beamrail

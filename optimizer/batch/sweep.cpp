@@ -4,8 +4,6 @@
 
 #include "optimizer/batch/progress.hpp"
 #include "optimizer/batch/sampling.hpp"
-#include "optimizer/output/summary.hpp"
-#include "optimizer/output/sweep_report.hpp"
 #include "optimizer/run/designs.hpp"
 
 namespace beamrail {
@@ -46,23 +44,6 @@ SweepRun sweep(const Study& study, const DesignEvaluator& evaluator, const RunSe
   run.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;
-}
-
-int run_sweep(const Study& study, const RunSettings& settings) {
-  const auto start = std::chrono::steady_clock::now();
-  const DesignEvaluator evaluator(study);
-  if (!evaluator.setup_failure().empty())
-    return fail_before_designs(study, settings.output, "sweep", evaluator.setup_failure());
-  SweepTable table(study, settings);
-  if (const int status = table.open()) return status;
-  SweepRun run =
-      sweep(study, evaluator, settings, table.resumed(), table.resumed_failed(),
-            [&](long i, const Design& x, const DesignOutcome& o) { return table.append(i, x, o); });
-  const bool written = table.finalize();
-  // The whole run's time, the evaluator's set-up and the table's sorting included.
-  run.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return report_sweep(study, settings, table, run, written);
 }
 
 }  // namespace beamrail

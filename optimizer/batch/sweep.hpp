@@ -2,7 +2,8 @@
 // one process or the ranks of an MPI job), one row of samples.csv per design in index order.
 //
 // sweep() computes and hands each design's outcome on as it ends; output/sweep_report.hpp writes
-// samples.csv (and reads it back for --resume) and summary.json; run_sweep() joins the two.
+// samples.csv (and reads it back for --resume) and summary.json; cli/batch_commands.hpp joins the
+// two, prints and returns the exit status.
 #pragma once
 
 #include <functional>
@@ -32,8 +33,5 @@ struct SweepRun {
 SweepRun sweep(const Study& study, const DesignEvaluator& evaluator, const RunSettings& settings,
                const std::set<long>& done, long shown_failed,
                const std::function<bool(long, const Design&, const DesignOutcome&)>& row);
-
-// Runs the sweep of study.design; writes samples.csv and summary.json. Returns the exit status.
-int run_sweep(const Study& study, const RunSettings& settings);
 
 }  // namespace beamrail

@@ -3,14 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <iostream>
 #include <limits>
 #include <mutex>
 
 #include "core/analysis/stop_request.hpp"
 #include "optimizer/batch/mpi_job.hpp"
 #include "optimizer/batch/wire.hpp"
-#include "optimizer/output/work_precision_report.hpp"
 
 namespace beamrail {
 namespace {
@@ -213,25 +211,6 @@ WorkPrecisionResult measure_work_precision(const Study& study, const PrecisionRe
   std::sort(result.runs.begin(), result.runs.end(),
             [](const PrecisionRun& a, const PrecisionRun& b) { return a.index < b.index; });
   return result;
-}
-
-int run_work_precision(const Study& study, const RunSettings& settings) {
-  const PrecisionReference reference = run_reference(study);
-  if (!reference.result.ok) return report_no_runs(study, settings, reference, "");
-  WorkPrecisionTable table;
-  std::string error;
-  if (!table.open(settings.output, &error))
-    return report_no_runs(study, settings, reference, error);
-  const WorkPrecisionResult result =
-      measure_work_precision(study, reference, [&](const PrecisionRun& r) {
-        if (!settings.quiet)
-          std::cerr << r.method << " rtol " << format_number(r.rtol) << ": error "
-                    << format_number(r.error) << ", " << r.stats.wall_seconds << " s ("
-                    << r.status() << ")\n";
-        return table.add(r);
-      });
-  const bool written = table.commit(&error);
-  return report_work_precision(study, settings, reference, result, written ? "" : error);
 }
 
 }  // namespace beamrail

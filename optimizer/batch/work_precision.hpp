@@ -4,7 +4,7 @@
 // measure_work_precision() computes: the reference run, then the runs one after another in one
 // process, or under mpirun one at a time per rank (rank 0 included), each rank comparing its run
 // with the reference trajectory rank 0 sends it. output/work_precision_report.hpp writes the table
-// and summary.json; run_work_precision() joins the two.
+// and summary.json; cli/batch_commands.hpp joins the two, prints and returns the exit status.
 #pragma once
 
 #include <functional>
@@ -13,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "optimizer/batch/run_settings.hpp"
 #include "optimizer/run/status.hpp"
 #include "optimizer/run/trajectory.hpp"
 #include "optimizer/study/study.hpp"
@@ -70,9 +69,5 @@ std::vector<char> pack_precision_task(long index, const Trajectory& reference);
 std::vector<char> run_precision_task(const Study* study, const std::vector<char>& task,
                                      SparseStructureCache* structures);
 PrecisionRun unpack_precision_run(const std::vector<char>& bytes);
-
-// Writes work_precision.csv (method, rtol, atol, error vs the reference, wall s, steps, rhs and
-// Jacobian evaluations, status) and summary.json. Returns the exit status.
-int run_work_precision(const Study& study, const RunSettings& settings);
 
 }  // namespace beamrail

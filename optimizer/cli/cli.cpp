@@ -8,11 +8,8 @@
 
 #include "core/analysis/stop_request.hpp"
 #include "optimizer/batch/mpi_job.hpp"
-#include "optimizer/batch/optimize.hpp"
 #include "optimizer/batch/run_settings.hpp"
-#include "optimizer/batch/sensitivity_study.hpp"
-#include "optimizer/batch/sweep.hpp"
-#include "optimizer/batch/work_precision.hpp"
+#include "optimizer/cli/batch_commands.hpp"
 #include "optimizer/cli/interruption.hpp"
 #include "optimizer/output/output_folder.hpp"
 #include "optimizer/output/result_tables.hpp"
@@ -22,6 +19,7 @@
 #include "optimizer/output/vtk_design.hpp"
 #include "optimizer/output/vtk_output.hpp"
 #include "optimizer/run/evaluation.hpp"
+#include "optimizer/run/status.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
@@ -247,11 +245,12 @@ int run(const RunArguments& args) {
                                         : std::filesystem::path(args.output);
   // Held until the run ends: a second run into the same folder is refused.
   OutputFolder folder;
-  std::string error;
-  if (!folder.acquire(out, &error)) {
+  std::string error, warning;
+  if (!folder.acquire(out, &error, &warning)) {
     std::cerr << "beamrail: " << error << "\n";
     return 1;
   }
+  if (!warning.empty()) std::cerr << "warning: " << warning << "\n";
   const std::string table = resumable_table(*study);
   if (args.resume && !table.empty()) {
     const std::string refusal = resume_refusal(*study, out, table);

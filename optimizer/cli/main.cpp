@@ -11,7 +11,8 @@ int main(int argc, char** argv) {
   beamrail::MpiJob job(&argc, &argv);
   if (job.rank() > 0) {
     const beamrail::StopOnSignals signals;
-    return job.serve();
+    job.serve();
+    return 0;
   }
   return beamrail::run_command_line(std::vector<std::string>(argv + 1, argv + argc));
 }

@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <iostream>
 #include <map>
 #include <sstream>
 
@@ -150,20 +149,6 @@ bool BatchTable::finalize(const std::vector<int>& key_columns, std::string* erro
   std::string text = join(header_);
   for (const auto& [key, row] : rows) text += join(row);
   return write_file_atomically(path_, text, error);
-}
-
-int open_exit_status(BatchTable::Opened opened, const std::string& error) {
-  switch (opened) {
-    case BatchTable::Opened::kOk:
-      return 0;
-    case BatchTable::Opened::kOtherColumns:
-      std::cerr << "beamrail: " << error << "\n";
-      return 2;
-    case BatchTable::Opened::kWriteError:
-      break;
-  }
-  std::cerr << "beamrail: " << error << "\n";
-  return 1;
 }
 
 }  // namespace beamrail

@@ -48,9 +48,4 @@ class BatchTable {
   std::mutex mutex_;
 };
 
-// A study's exit status for the outcome of BatchTable::open: 0 when it opened; else prints the
-// error and returns 2 (a resumed table of other columns: the study was edited) or 1 (a write
-// error).
-int open_exit_status(BatchTable::Opened opened, const std::string& error);
-
 }  // namespace beamrail

@@ -4,10 +4,8 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <iostream>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/cli/interruption.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
@@ -38,7 +36,7 @@ CsvRow history_row(const OptimizationRecord& r) {
   return out;
 }
 
-int OptimizationFiles::open() {
+BatchTable::Opened OptimizationFiles::open() {
   const std::vector<DesignVariable>& variables = problem_.variables();
   const std::vector<ResponseSpec>& responses = problem_.study().responses;
   // A best design of an earlier run must not stand beside this run's history.
@@ -47,11 +45,11 @@ int OptimizationFiles::open() {
     std::filesystem::remove(settings_.output / stale, ec);
   }
   std::vector<CsvRow> existing;
-  if (const int status =
-          open_exit_status(history_.open(settings_.output / "history.csv", history_header(problem_),
-                                         settings_.resume, &existing, &error_),
-                           error_))
-    return status;
+  if (const BatchTable::Opened opened =
+          history_.open(settings_.output / "history.csv", history_header(problem_),
+                        settings_.resume, &existing, &error_);
+      opened != BatchTable::Opened::kOk)
+    return opened;
   const size_t nv = variables.size(), nr = responses.size();
   for (const CsvRow& r : existing) {
     ResumedRow row;
@@ -67,17 +65,16 @@ int OptimizationFiles::open() {
     resumed_.push_back(std::move(row));
   }
   // The derivatives of earlier designs (exact gradients), by design.
-  if (!problem_.exact_gradients()) return 0;
+  if (!problem_.exact_gradients()) return BatchTable::Opened::kOk;
   CsvRow columns;
   for (const DesignVariable& v : variables) columns.push_back(v.name);
   for (const ResponseSpec& r : responses)
     for (const DesignVariable& v : variables) columns.push_back("d " + r.name + " / d " + v.name);
   std::vector<CsvRow> rows;
-  if (const int status =
-          open_exit_status(derivatives_.open(settings_.output / "derivatives.csv", columns,
-                                             settings_.resume, &rows, &error_),
-                           error_))
-    return status;
+  if (const BatchTable::Opened opened = derivatives_.open(
+          settings_.output / "derivatives.csv", columns, settings_.resume, &rows, &error_);
+      opened != BatchTable::Opened::kOk)
+    return opened;
   for (const CsvRow& r : rows) {
     Design x;
     for (size_t i = 0; i < nv; ++i) x.push_back(std::strtod(r[i].c_str(), nullptr));
@@ -87,7 +84,7 @@ int OptimizationFiles::open() {
         jacobian(k, j) = std::strtod(r[nv + k * nv + j].c_str(), nullptr);
     derivatives_read_.emplace_back(std::move(x), std::move(jacobian));
   }
-  return 0;
+  return BatchTable::Opened::kOk;
 }
 
 void OptimizationFiles::record(const OptimizationRecord& r) {
@@ -216,9 +213,10 @@ StopMeaning meaning_of(int index, nlopt_result result, bool stopped_by_us,
 
 }  // namespace
 
-int report_optimization(const OptimizationProblem& problem, const DesignEvaluator& evaluator,
-                        const RunSettings& settings_, const OptimizationRun& run,
-                        const std::string& history_error) {
+OptimizationReport report_optimization(const OptimizationProblem& problem,
+                                       const DesignEvaluator& evaluator,
+                                       const RunSettings& settings_, const OptimizationRun& run,
+                                       const std::string& history_error) {
   const Study& study_ = problem.study();
   const OptimizePlan& plan_ = problem.plan();
   const std::vector<DesignVariable>& variables_ = problem.variables();
@@ -386,35 +384,23 @@ int report_optimization(const OptimizationProblem& problem, const DesignEvaluato
     }
   }
   ok = ok && write_file_atomically(settings_.output / "summary.json", s.dump(2) + "\n", &error);
-  for (size_t k = study_.input_warnings.size(); k < warnings.size(); ++k)
-    std::cerr << "warning: " << warnings[k] << "\n";
+  OptimizationReport report;
+  report.status = status;
+  report.warnings.assign(warnings.begin() + static_cast<long>(study_.input_warnings.size()),
+                         warnings.end());
+  if (best) report.best = *best;
+  RunOutcome& outcome = report.outcome;
+  outcome.message = message;
   if (!ok) {
-    std::cerr << "beamrail: " << error << "\n";
-    return 1;
+    outcome.kind = RunOutcome::Kind::kWriteError;
+    outcome.errors.push_back(error);
+  } else if (status == RunStatus::kInterrupted) {
+    outcome.kind = RunOutcome::Kind::kInterrupted;
+    outcome.signal = signal;
+  } else if (status != RunStatus::kOk) {
+    outcome.kind = RunOutcome::Kind::kFailed;  // failed, or no design is feasible
   }
-  const std::string history = (settings_.output / "history.csv").string();
-  if (status == RunStatus::kFailed) {
-    std::cerr << "beamrail: " << study_.name << " failed: " << message << "\n(" << records_.size()
-              << " designs evaluated are in " << history << "; no best.json is written)\n";
-    return 1;
-  }
-  if (status == RunStatus::kInterrupted) {
-    std::cerr << "beamrail: " << study_.name << " interrupted by " << signal_name(signal) << ": "
-              << records_.size() << " designs are in " << history
-              << "; continue with: " << settings_.command << " --resume\n";
-    return interrupted_exit_status(signal);
-  }
-  if (!best) {
-    std::cerr << "beamrail: " << study_.name << ": " << message << " (" << records_.size()
-              << " designs evaluated); see " << history << "\n";
-    return 1;
-  }
-  std::cout << study_.name << ": best objective " << format_number(best->objective) << " at";
-  for (size_t i = 0; i < variables_.size(); ++i)
-    std::cout << " " << variables_[i].name << " = " << format_number(best->x[i]);
-  std::cout << " (" << records_.size() << " designs, " << wall << " s) -> "
-            << settings_.output.string() << "\n";
-  return 0;
+  return report;
 }
 
 }  // namespace beamrail

@@ -7,7 +7,6 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
-#include <iostream>
 #include <sstream>
 
 #include "optimizer/output/tables.hpp"
@@ -40,7 +39,7 @@ OutputFolder::~OutputFolder() {
   if (fd_ >= 0) ::close(fd_);  // releases the lock
 }
 
-bool OutputFolder::acquire(const fs::path& directory, std::string* error) {
+bool OutputFolder::acquire(const fs::path& directory, std::string* error, std::string* warning) {
   directory_ = directory;
   std::error_code ec;
   fs::create_directories(directory, ec);
@@ -59,8 +58,8 @@ bool OutputFolder::acquire(const fs::path& directory, std::string* error) {
     const int e = errno;
     if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS) {
       // A file system without locks (some network file systems): run, but say what is missing.
-      std::cerr << "warning: cannot lock " << lock.string() << " (" << std::strerror(e)
-                << "): a second run into " << directory.string() << " would not be refused\n";
+      *warning = "cannot lock " + lock.string() + " (" + std::strerror(e) + "): a second run into " +
+                 directory.string() + " would not be refused";
       return true;
     }
     if (e == EWOULDBLOCK) {

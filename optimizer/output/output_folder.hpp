@@ -22,8 +22,9 @@ class OutputFolder {
   OutputFolder& operator=(const OutputFolder&) = delete;
 
   // Creates the folder when needed and takes its lock. False with *error naming the folder and
-  // the reason: it cannot be created or written, or another run holds it.
-  bool acquire(const std::filesystem::path& directory, std::string* error);
+  // the reason: it cannot be created or written, or another run holds it. On a file system
+  // without locks it goes on without one, saying so in *warning (else left as it was).
+  bool acquire(const std::filesystem::path& directory, std::string* error, std::string* warning);
 
   // Records the study (resolved_study.json) and replaces summary.json by the "running" marker.
   // False with *error naming the file and the reason.

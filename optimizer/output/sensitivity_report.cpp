@@ -1,8 +1,8 @@
 #include "optimizer/output/sensitivity_report.hpp"
 
 #include <cmath>
-#include <iostream>
 
+#include "core/analysis/stop_request.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
@@ -17,9 +17,9 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
-int report_sensitivity(const Study& study, const RunSettings& settings,
-                       const SensitivityResult& result,
-                       std::chrono::steady_clock::time_point start) {
+SensitivityReport report_sensitivity(const Study& study, const RunSettings& settings,
+                                     const SensitivityResult& result,
+                                     std::chrono::steady_clock::time_point start) {
   const DesignStudy& plan = *study.design;
   const std::vector<double>& x = result.x;
   const DesignOutcome& design = result.design;
@@ -53,19 +53,19 @@ int report_sensitivity(const Study& study, const RunSettings& settings,
     written = table.commit(&error);
   }
 
-  std::string status = status_name(Status::kOk), message;
+  RunStatus status = RunStatus::kOk;
+  std::string message;
   if (design.status != Status::kOk) {
-    status = design.status == Status::kInterrupted ? status_name(Status::kInterrupted)
-                                                   : status_name(Status::kFailed);
+    status = design.status == Status::kInterrupted ? RunStatus::kInterrupted : RunStatus::kFailed;
     message = "the study's design did not evaluate: " + design.message;
   } else if (!s.ok) {
-    status = status_name(Status::kFailed);
+    status = RunStatus::kFailed;
     message = s.message;
   } else if (!check_failure.empty()) {
-    status = status_name(Status::kFailed);
+    status = RunStatus::kFailed;
     message = check_failure;
   } else if (!written) {
-    status = status_name(Status::kFailed);
+    status = RunStatus::kFailed;
     message = error;
   }
   nlohmann::json summary;
@@ -73,7 +73,7 @@ int report_sensitivity(const Study& study, const RunSettings& settings,
   summary["file"] = study.file;
   summary["beamrail_version"] = kVersion;
   summary["type"] = "sensitivity";
-  summary["status"] = status;
+  summary["status"] = run_status_name(status);
   summary["message"] = message;
   std::vector<std::string> warnings = study.input_warnings;
   if (design.warnings > 0) warnings.push_back(design.message);
@@ -93,26 +93,27 @@ int report_sensitivity(const Study& study, const RunSettings& settings,
     summary["check_step"] = plan.sensitivity.check_step;
     summary["largest_relative_difference"] = worst;
   }
-  summary["wall_seconds"] = seconds_since(start);
+  SensitivityReport report;
+  report.status = status;
+  report.warnings = warnings;
+  report.largest_relative_difference = worst;
+  report.wall_seconds = seconds_since(start);
+  summary["wall_seconds"] = report.wall_seconds;
   summary["model"] = model_summary(study.model);
+  RunOutcome& outcome = report.outcome;
+  outcome.message = message;
   std::string summary_error;
   if (!write_file_atomically(settings.output / "summary.json", summary.dump(2) + "\n",
                              &summary_error)) {
-    std::cerr << "beamrail: " << summary_error << "\n";
-    return 1;
+    outcome.kind = RunOutcome::Kind::kWriteError;
+    outcome.errors.push_back(summary_error);
+  } else if (status == RunStatus::kInterrupted) {
+    outcome.kind = RunOutcome::Kind::kInterrupted;
+    outcome.signal = stop_requested();
+  } else if (status != RunStatus::kOk) {
+    outcome.kind = RunOutcome::Kind::kFailed;
   }
-  for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
-  if (status != status_name(Status::kOk)) {
-    std::cerr << "beamrail: " << study.name << " " << status << ": " << message << "\n";
-    return 1;
-  }
-  std::cout << study.name << ": derivatives of " << nr << " responses with respect to " << nv
-            << " variables in " << seconds_since(start) << " s";
-  if (plan.sensitivity.check)
-    std::cout << " (largest relative difference from central differences " << format_number(worst)
-              << ")";
-  std::cout << " -> " << settings.output.string() << "\n";
-  return 0;
+  return report;
 }
 
 }  // namespace beamrail

@@ -1,7 +1,6 @@
 #include "optimizer/output/summary.hpp"
 
 #include <cmath>
-#include <iostream>
 
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
@@ -14,20 +13,22 @@ nlohmann::json json_number(double x) {
   return x;
 }
 
-int fail_before_designs(const Study& study, const std::filesystem::path& output,
-                        const std::string& type, const std::string& message) {
+RunOutcome fail_before_designs(const Study& study, const std::filesystem::path& output,
+                               const std::string& type, const std::string& message) {
   const nlohmann::json s{{"study", study.name},
                          {"file", study.file},
                          {"beamrail_version", kVersion},
                          {"type", type},
-                         {"status", status_name(Status::kFailed)},
+                         {"status", run_status_name(RunStatus::kFailed)},
                          {"message", message},
                          {"warnings", study.input_warnings}};
+  RunOutcome outcome;
+  outcome.kind = RunOutcome::Kind::kFailed;
+  outcome.message = message;
   std::string error;
   if (!write_file_atomically(output / "summary.json", s.dump(2) + "\n", &error))
-    std::cerr << "beamrail: " << error << "\n";
-  std::cerr << "beamrail: " << study.name << " failed: " << message << "\n";
-  return 1;
+    outcome.errors.push_back(error);
+  return outcome;
 }
 
 nlohmann::json model_summary(const Model& model) {

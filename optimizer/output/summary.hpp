@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "optimizer/output/run_outcome.hpp"
 #include "optimizer/run/evaluation.hpp"
 #include "optimizer/study/study.hpp"
 
@@ -21,8 +22,9 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
 nlohmann::json json_number(double x);
 
 // Writes the summary of a batch that failed before its first design (`type`: "sweep",
-// "optimize"); prints the message and returns exit status 1.
-int fail_before_designs(const Study& study, const std::filesystem::path& output,
-                        const std::string& type, const std::string& message);
+// "optimize", "sensitivity"): kFailed with `message`, and the error when the summary could not be
+// written.
+RunOutcome fail_before_designs(const Study& study, const std::filesystem::path& output,
+                               const std::string& type, const std::string& message);
 
 }  // namespace beamrail

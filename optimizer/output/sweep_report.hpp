@@ -1,6 +1,6 @@
 // The files of a sweep (docs/study_files.md "Outputs"): samples.csv, a row per design written as
 // designs end and read back by --resume, then sorted into index order; summary.json. Writing
-// only: no design is evaluated here.
+// only: no design is evaluated here, and nothing is printed (cli/batch_commands.hpp prints).
 #pragma once
 
 #include <set>
@@ -8,6 +8,7 @@
 
 #include "optimizer/batch/sweep.hpp"
 #include "optimizer/output/batch_table.hpp"
+#include "optimizer/output/run_outcome.hpp"
 
 namespace beamrail {
 
@@ -15,9 +16,9 @@ class SweepTable {
  public:
   SweepTable(const Study& study, const RunSettings& settings);
 
-  // Opens samples.csv fresh or, with --resume, reading back its rows. Returns 0, or the exit
-  // status after printing the error (open_exit_status).
-  int open();
+  // Opens samples.csv fresh or, with --resume, reading back its rows; anything but kOk with
+  // error() saying why.
+  BatchTable::Opened open();
   // The designs already in the table (--resume), and how many of them failed or had warnings.
   const std::set<long>& resumed() const { return resumed_; }
   long resumed_failed() const { return resumed_failed_; }
@@ -39,9 +40,17 @@ class SweepTable {
   std::string error_;
 };
 
-// Writes summary.json and prints the result. `written`: whether the table was. Returns the exit
-// status: 0, 1 (a write error), or that of the signal that interrupted the sweep.
-int report_sweep(const Study& study, const RunSettings& settings, const SweepTable& table,
-                 const SweepRun& run, bool written);
+// What report_sweep wrote: the outcome (kOk, kInterrupted, kWriteError) and the counts of the
+// whole table, this run's designs and those resumed.
+struct SweepReport {
+  RunOutcome outcome;
+  long finished = 0;       // designs in the table
+  long failed = 0;         // of them, failed or invalid
+  long with_warnings = 0;  // of them, with warnings
+};
+
+// Writes summary.json. `written`: whether the table was (table.error() says why not).
+SweepReport report_sweep(const Study& study, const RunSettings& settings, const SweepTable& table,
+                         const SweepRun& run, bool written);
 
 }  // namespace beamrail

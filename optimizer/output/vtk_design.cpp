@@ -2,14 +2,11 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <iostream>
 #include <sstream>
 
 #include "optimizer/batch/sampling.hpp"
 #include "optimizer/output/batch_table.hpp"
 #include "optimizer/output/tables.hpp"
-#include "optimizer/output/vtk_output.hpp"
-#include "optimizer/run/evaluation.hpp"
 
 namespace beamrail {
 
@@ -111,13 +108,20 @@ std::string choose_design(const Study& study, bool vtk, const std::string* desig
   return "";
 }
 
-int draw_design(const Study& study, const DesignChoice& choice, const fs::path& output,
-                bool quiet) {
-  if (choice.kind == DesignChoice::Kind::kNone) return 0;
+DesignToDraw design_to_draw(const Study& study, const DesignChoice& choice,
+                            const fs::path& output) {
+  DesignToDraw out;
+  out.description = describe(choice);
+  // Why the design cannot be drawn.
+  const auto refuse = [&out](RunOutcome::Kind kind, const std::string& message) {
+    out.outcome.kind = kind;
+    out.outcome.message = message;
+    return std::move(out);
+  };
   const std::vector<DesignVariable> none;
   const std::vector<DesignVariable>& variables = study.design ? study.design->variables : none;
   std::vector<double> x;
-  nlohmann::json design;
+  nlohmann::json& design = out.record;
   design["study_type"] = study.design->type == DesignStudy::Type::kSweep      ? "sweep"
                          : study.design->type == DesignStudy::Type::kOptimize ? "optimize"
                          : study.design->type == DesignStudy::Type::kWorkPrecision
@@ -132,10 +136,9 @@ int draw_design(const Study& study, const DesignChoice& choice, const fs::path& 
     case DesignChoice::Kind::kBest: {
       const fs::path file = output / "best.json";
       const nlohmann::json best = nlohmann::json::parse(read_text(file), nullptr, false);
-      if (best.is_discarded() || !best.contains("variables")) {
-        std::cerr << "beamrail: no VTK files: " << file.string() << " cannot be read\n";
-        return 1;
-      }
+      if (best.is_discarded() || !best.contains("variables"))
+        return refuse(RunOutcome::Kind::kFailed,
+                      "no VTK files: " + file.string() + " cannot be read");
       for (const DesignVariable& v : variables) x.push_back(best["variables"].value(v.name, 0.0));
       design["which"] = "best";
       design["start"] = best.value("start", 0);
@@ -162,12 +165,13 @@ int draw_design(const Study& study, const DesignChoice& choice, const fs::path& 
         if (e != choice.evaluation) continue;
         for (size_t c : columns) x.push_back(std::strtod(row[c].c_str(), nullptr));
       }
-      if (x.empty()) {
-        std::cerr << "beamrail: --design " << choice.start << ":" << choice.evaluation << ": "
-                  << file.string() << " has no such row (start " << choice.start << " holds "
-                  << (last > 0 ? "evaluations 1.." + std::to_string(last) : "no rows") << ")\n";
-        return 2;
-      }
+      if (x.empty())
+        return refuse(RunOutcome::Kind::kBadInput,
+                      "--design " + std::to_string(choice.start) + ":" +
+                          std::to_string(choice.evaluation) + ": " + file.string() +
+                          " has no such row (start " + std::to_string(choice.start) + " holds " +
+                          (last > 0 ? "evaluations 1.." + std::to_string(last) : "no rows") +
+                          ")");
       design["which"] = "row";
       design["start"] = choice.start;
       design["evaluation"] = choice.evaluation;
@@ -194,33 +198,14 @@ int draw_design(const Study& study, const DesignChoice& choice, const fs::path& 
     design["variables"] = values;
   }
   Diagnostics diag;
-  const std::optional<Study> drawn =
-      load_study(document, study.file, study.directory, diag, &study.model.segment_choices);
-  if (!drawn) {
-    std::cerr << "beamrail: no VTK files: " << describe(choice) << " is invalid:\n"
-              << diag.format();
-    return 1;
+  out.study = load_study(document, study.file, study.directory, diag, &study.model.segment_choices);
+  if (!out.study) {
+    std::string problems = diag.format();
+    if (!problems.empty() && problems.back() == '\n') problems.pop_back();
+    return refuse(RunOutcome::Kind::kFailed,
+                  "no VTK files: " + describe(choice) + " is invalid:\n" + problems);
   }
-  VtkOutput vtk(output / "vtk");
-  EvaluationOptions options;
-  options.vtk = &vtk;
-  const Evaluation ev = evaluate(*drawn, drawn->model, options);
-  design["status"] = status_name(ev.status);
-  design["message"] = ev.message;
-  std::string error;
-  if (!vtk.finish(design, &error)) {
-    std::cerr << "beamrail: " << error << "\n";
-    return 1;
-  }
-  if (ev.status != Status::kOk) {
-    std::cerr << "beamrail: the VTK files of " << describe(choice)
-              << " are incomplete: " << status_name(ev.status) << ": " << ev.message << "\n";
-    return 1;
-  }
-  if (!quiet)
-    std::cerr << "beamrail: VTK files of " << describe(choice) << " in "
-              << (output / "vtk").string() << " (open a .pvd in ParaView)\n";
-  return 0;
+  return out;
 }
 
 }  // namespace beamrail

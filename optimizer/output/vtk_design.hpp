@@ -6,8 +6,11 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "optimizer/output/run_outcome.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
@@ -27,11 +30,19 @@ struct DesignChoice {
 std::string choose_design(const Study& study, bool vtk, const std::string* design,
                           DesignChoice* choice);
 
-// Draws the chosen design of a design study whose batch has run into `output`: evaluates it again
-// with VTK output into <output>/vtk. Returns the exit status: 0; 1 when the design cannot be
-// evaluated or the files written; 2 when the chosen row is not in the table (an optimization
-// that stopped before that evaluation).
-int draw_design(const Study& study, const DesignChoice& choice, const std::filesystem::path& output,
-                bool quiet);
+// The design a design study's VTK files draw (`choice`, not kNone), read from the batch's files
+// in `output`: outcome kOk with the design's study (rebuilt from its values) and what the VTK
+// files record of it, or why it cannot be drawn (`outcome.message`): kFailed (best.json cannot be
+// read, the design is invalid), kBadInput (the chosen row is not in history.csv: an optimization
+// that stopped before that evaluation). Reads only: cli/batch_commands.hpp evaluates the design
+// with VTK output.
+struct DesignToDraw {
+  RunOutcome outcome;
+  std::optional<Study> study;
+  nlohmann::json record;    // the "design" entry of the VTK files: which design, its values
+  std::string description;  // "the best design", "design 3", "design 2:14", "the study's own design"
+};
+DesignToDraw design_to_draw(const Study& study, const DesignChoice& choice,
+                            const std::filesystem::path& output);
 
 }  // namespace beamrail

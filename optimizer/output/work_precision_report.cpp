@@ -1,10 +1,8 @@
 #include "optimizer/output/work_precision_report.hpp"
 
-#include <iostream>
 #include <limits>
 
 #include "core/analysis/stop_request.hpp"
-#include "optimizer/cli/interruption.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/version.hpp"
 #include "optimizer/run/status.hpp"
@@ -52,50 +50,57 @@ nlohmann::json base_summary(const Study& study) {
   return s;
 }
 
-// Writes the summary with its status and message; false (printed) when it cannot be written.
+// Writes the summary with its status and message; false, with the error in outcome.errors, when
+// it cannot be written.
 bool write_summary(nlohmann::json& s, const Study& study, const RunSettings& settings,
-                   const std::string& status, const std::string& message) {
-  s["status"] = status;
+                   RunStatus status, const std::string& message, RunOutcome& outcome) {
+  s["status"] = run_status_name(status);
   s["message"] = message;
   s["model"] = model_summary(study.model);
   std::string error;
   if (write_file_atomically(settings.output / "summary.json", s.dump(2) + "\n", &error))
     return true;
-  std::cerr << "beamrail: " << error << "\n";
+  outcome.errors.push_back(error);
   return false;
 }
 
 }  // namespace
 
-int report_no_runs(const Study& study, const RunSettings& settings,
-                   const PrecisionReference& reference, const std::string& table_error) {
+WorkPrecisionReport report_no_runs(const Study& study, const RunSettings& settings,
+                                   const PrecisionReference& reference,
+                                   const std::string& table_error) {
   nlohmann::json s = base_summary(study);
+  WorkPrecisionReport report;
+  RunOutcome& outcome = report.outcome;
   if (reference.result.interrupted) {
     const int signal = stop_requested();
-    write_summary(s, study, settings, status_name(Status::kInterrupted),
-                  "interrupted by " + signal_name(signal) + " in the reference run");
-    std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal)
-              << " in the reference run; nothing to keep\n";
-    return interrupted_exit_status(signal);
+    outcome.kind = RunOutcome::Kind::kInterrupted;
+    outcome.signal = signal;
+    outcome.message = "interrupted by " + signal_name(signal) + " in the reference run";
+    report.in_reference = true;
+    write_summary(s, study, settings, RunStatus::kInterrupted, outcome.message, outcome);
+    return report;
   }
-  const std::string message =
-      !reference.result.ok ? "the reference run failed: " + reference.result.message : table_error;
-  write_summary(s, study, settings, status_name(Status::kFailed), message);
-  std::cerr << "beamrail: " << message << "\n";
-  return 1;
+  const bool failed = !reference.result.ok;
+  outcome.message = failed ? "the reference run failed: " + reference.result.message : table_error;
+  write_summary(s, study, settings, RunStatus::kFailed, outcome.message, outcome);
+  outcome.kind = failed ? RunOutcome::Kind::kFailed : RunOutcome::Kind::kWriteError;
+  if (!failed) outcome.errors.push_back(table_error);
+  return report;
 }
 
-int report_work_precision(const Study& study, const RunSettings& settings,
-                          const PrecisionReference& reference, const WorkPrecisionResult& result,
-                          const std::string& table_error) {
+WorkPrecisionReport report_work_precision(const Study& study, const RunSettings& settings,
+                                          const PrecisionReference& reference,
+                                          const WorkPrecisionResult& result,
+                                          const std::string& table_error) {
   const WorkPrecisionPlan& plan = study.design->work_precision;
   nlohmann::json summary = base_summary(study);
+  WorkPrecisionReport report;
   // The fastest run within the target error (the first of equal times, in plan order).
   nlohmann::json best = nullptr;
   double best_wall = std::numeric_limits<double>::infinity();
-  long failed = 0;
   for (const PrecisionRun& r : result.runs) {
-    failed += !r.ok;
+    report.failed += !r.ok;
     if (r.ok && r.error <= plan.target_error && r.stats.wall_seconds < best_wall) {
       best_wall = r.stats.wall_seconds;
       best = {{"method", r.method},
@@ -104,13 +109,17 @@ int report_work_precision(const Study& study, const RunSettings& settings,
               {"error", r.error},
               {"wall_seconds", r.stats.wall_seconds},
               {"steps", r.stats.steps}};
+      report.fastest_method = r.method;
+      report.fastest_rtol = r.rtol;
+      report.fastest_seconds = r.stats.wall_seconds;
     }
   }
-  const long runs = static_cast<long>(result.runs.size());
+  report.runs = static_cast<long>(result.runs.size());
+  report.planned = result.planned;
   const int signal = stop_requested();
-  const bool interrupted = result.interrupted || (signal != 0 && runs < result.planned);
-  summary["runs"] = runs;
-  summary["failed_or_timeout"] = failed;
+  const bool interrupted = result.interrupted || (signal != 0 && report.runs < result.planned);
+  summary["runs"] = report.runs;
+  summary["failed_or_timeout"] = report.failed;
   summary["target_error"] = plan.target_error;
   summary["fastest_within_target"] = best;
   summary["reference"] = {{"method", method_name(plan.reference.method)},
@@ -123,31 +132,29 @@ int report_work_precision(const Study& study, const RunSettings& settings,
       "distance a body moved in the reference run";
   summary["ranks"] = result.ranks;
   if (result.ranks > 1) summary["runs_per_rank"] = result.runs_per_rank;
+  RunOutcome& outcome = report.outcome;
   if (!table_error.empty()) {
-    write_summary(summary, study, settings, status_name(Status::kFailed), table_error);
-    std::cerr << "beamrail: " << table_error << "\n";
-    return 1;
+    write_summary(summary, study, settings, RunStatus::kFailed, table_error, outcome);
+    outcome.kind = RunOutcome::Kind::kWriteError;
+    outcome.errors.push_back(table_error);
+    return report;
   }
   if (interrupted) {
-    if (!write_summary(summary, study, settings, status_name(Status::kInterrupted),
-                       "interrupted by " + signal_name(signal) + " after " + std::to_string(runs) +
-                           " of " + std::to_string(result.planned) + " runs"))
-      return 1;
-    std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(signal) << ": "
-              << runs << " of " << result.planned << " runs are in "
-              << (settings.output / "work_precision.csv").string()
-              << "; a work-precision study does not resume: run it again to measure them all\n";
-    return interrupted_exit_status(signal);
+    outcome.message = "interrupted by " + signal_name(signal) + " after " +
+                      std::to_string(report.runs) + " of " + std::to_string(result.planned) +
+                      " runs";
+    if (!write_summary(summary, study, settings, RunStatus::kInterrupted, outcome.message,
+                       outcome)) {
+      outcome.kind = RunOutcome::Kind::kWriteError;
+      return report;
+    }
+    outcome.kind = RunOutcome::Kind::kInterrupted;
+    outcome.signal = signal;
+    return report;
   }
-  if (!write_summary(summary, study, settings, status_name(Status::kOk), "")) return 1;
-  std::cout << study.name << ": " << runs << " runs (" << failed << " failed or timed out)";
-  if (!best.is_null())
-    std::cout << "; fastest within " << format_number(plan.target_error) << ": "
-              << best["method"].get<std::string>() << " at rtol "
-              << format_number(best["rtol"].get<double>()) << " in "
-              << best["wall_seconds"].get<double>() << " s";
-  std::cout << " -> " << settings.output.string() << "\n";
-  return 0;
+  if (!write_summary(summary, study, settings, RunStatus::kOk, "", outcome))
+    outcome.kind = RunOutcome::Kind::kWriteError;
+  return report;
 }
 
 }  // namespace beamrail

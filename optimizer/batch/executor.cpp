@@ -9,15 +9,26 @@
 
 namespace beamrail {
 
+namespace {
+
+// The outcome of a design whose evaluation threw.
+DesignOutcome thrown(const DesignEvaluator& evaluator, const std::string& message) {
+  DesignOutcome o;
+  o.status = Status::kFailed;
+  o.message = message;
+  o.responses.assign(evaluator.study().responses.size(), std::nan(""));
+  return o;
+}
+
+}  // namespace
+
 DesignOutcome evaluate_design(const DesignEvaluator& evaluator, const Design& x) {
   try {
     return evaluator.evaluate(x);
   } catch (const std::exception& e) {
-    DesignOutcome o;
-    o.status = Status::kFailed;
-    o.message = std::string("the evaluation threw: ") + e.what();
-    o.responses.assign(evaluator.study().responses.size(), std::nan(""));
-    return o;
+    return thrown(evaluator, std::string("the evaluation threw: ") + e.what());
+  } catch (...) {
+    return thrown(evaluator, std::string("the evaluation threw: ") + kUnknownException);
   }
 }
 

@@ -62,7 +62,7 @@ class ThreadExecutor : public BatchExecutor {
   ExecutorStats stats_{{0}, 0.0, 0.0};
 };
 
-// Evaluates one design, a thrown exception becoming a kFailed outcome.
+// Evaluates one design, a thrown exception (of any type) becoming a kFailed outcome.
 DesignOutcome evaluate_design(const DesignEvaluator& evaluator, const Design& x);
 
 // The executor of a batch of `work` designs run with `settings`: the ranks of the MPI job when

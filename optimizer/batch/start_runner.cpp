@@ -423,6 +423,12 @@ StartResult run_start(const OptimizationProblem& problem, const DesignEvaluator&
     r.result = NLOPT_FAILURE;
     r.message = std::string("the start threw: ") + e.what();
     return r;
+  } catch (...) {
+    StartResult r;
+    r.index = task.index;
+    r.result = NLOPT_FAILURE;
+    r.message = std::string("the start threw: ") + kUnknownException;
+    return r;
   }
 }
 

@@ -128,6 +128,8 @@ std::vector<char> run_start_task(const DesignEvaluator& evaluator, int threads,
     return pack_result(run_start(problem, evaluator, task, cache, threads, sink, cancel));
   } catch (const std::exception& e) {
     return failed_start_task(bytes, e.what());
+  } catch (...) {
+    return failed_start_task(bytes, kUnknownException);
   }
 }
 

@@ -121,7 +121,7 @@ std::vector<char> run_precision_task(const Study* study, const std::vector<char>
     if (study && study->design && study->design->type == DesignStudy::Type::kWorkPrecision)
       return pack_run(
           measure_run(*study, index, get_trajectory(u), structures ? structures : &own));
-  } catch (const std::exception&) {
+  } catch (...) {  // any type: a failed run
   }
   {
     PrecisionRun failed;  // what rank 0 reports as a failed run

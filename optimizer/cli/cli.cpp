@@ -314,6 +314,18 @@ int dispatch(const std::vector<std::string>& args) {
 
 }  // namespace
 
+int beamrail_main(int argc, char** argv) {
+  // Under mpirun (or srun) every rank starts here; rank 0 runs the command line, the others
+  // evaluate the designs it sends them (optimizer/batch/mpi_job.hpp).
+  MpiJob job(&argc, &argv);
+  if (job.rank() > 0) {
+    const StopOnSignals signals;
+    job.serve();
+    return 0;
+  }
+  return run_command_line(std::vector<std::string>(argv + 1, argv + argc));
+}
+
 int run_command_line(const std::vector<std::string>& args) {
   try {
     return dispatch(args);

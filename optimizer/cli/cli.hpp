@@ -11,4 +11,8 @@ namespace beamrail {
 // signal's number when SIGINT or SIGTERM interrupted the run. Never throws.
 int run_command_line(const std::vector<std::string>& args);
 
+// The whole process (main's body): joins the MPI job when an MPI launcher started it; rank 0 runs
+// the command line, the other ranks evaluate what rank 0 sends them. Returns the exit status.
+int beamrail_main(int argc, char** argv);
+
 }  // namespace beamrail

@@ -89,6 +89,10 @@ ResponseSensitivities DesignEvaluator::sensitivities(const std::vector<double>& 
       if (!directions[j]) refused[j] = problems(diag);
     } catch (const std::exception& e) {
       refused[j] = std::string("the scene's build on dual numbers failed: ") + e.what();
+    } catch (...) {
+      refused[j] =
+          "the scene's build on dual numbers threw an exception that is not a "
+          "std::exception";
     }
   }
   std::vector<DualModel> along;
@@ -166,6 +170,9 @@ DesignOutcome DesignEvaluator::evaluate(const std::vector<double>& x,
   } catch (const std::exception& e) {
     out.status = Status::kFailed;
     out.message = e.what();
+  } catch (...) {  // muparser's errors, say, are no std::exception
+    out.status = Status::kFailed;
+    out.message = kUnknownException;
   }
   for (char& c : out.message)  // a table row holds it on one line
     if (c == '\n' || c == '\r') c = ' ';

@@ -18,6 +18,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+AnalysisFault analysis_fault = nullptr;  // set_analysis_fault
+
 class Runner {
  public:
   Runner(const Study& study, const Model& model, const EvaluationOptions& options, Evaluation& ev,
@@ -30,6 +32,7 @@ class Runner {
 
   // Runs analysis `index` of the study; false when it failed (the evaluation then stops).
   bool run(int index) {
+    if (analysis_fault) analysis_fault(study_, model_, index);
     const AnalysisSpec& spec = study_.analyses[index];
     AnalysisReport report;
     report.type = type_name(spec.type);
@@ -447,6 +450,8 @@ class Runner {
 
 }  // namespace
 
+void set_analysis_fault(AnalysisFault fault) { analysis_fault = fault; }
+
 Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   Evaluation ev;
@@ -471,6 +476,9 @@ Evaluation evaluate(const Study& study, const Model& model, const EvaluationOpti
   } catch (const std::exception& e) {
     ev.status = Status::kFailed;
     ev.message = e.what();
+  } catch (...) {
+    ev.status = Status::kFailed;
+    ev.message = kUnknownException;
   }
   ev.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return ev;

@@ -163,7 +163,19 @@ struct EvaluationOptions {
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed
 // order, and computes the responses. Each analysis applies the loads of its load case. A static
 // equilibrium a modal or buckling analysis needs is that of the study's static analysis of the
-// same load case (solved once and shared), or one with default options. Never throws.
+// same load case (solved once and shared), or one with default options. Never throws: whatever an
+// analysis throws (a std::exception or not) ends the evaluation as kFailed with its message.
 Evaluation evaluate(const Study& study, const Model& model, const EvaluationOptions& options);
+
+// The message of an evaluation ended by an exception of no std::exception type.
+inline constexpr const char* kUnknownException =
+    "an analysis threw an exception that is not a std::exception";
+
+// A test seam: called before each analysis of every evaluation with the study, the model and the
+// analysis's index, it may throw as an analysis that fails by an exception would
+// (tests/support/faulty_beamrail.cpp injects faults to test what a throwing analysis does to a
+// batch). The beamrail command sets none. Set it before any evaluation starts.
+using AnalysisFault = void (*)(const Study& study, const Model& model, int analysis);
+void set_analysis_fault(AnalysisFault fault);
 
 }  // namespace beamrail

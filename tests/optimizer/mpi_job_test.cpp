@@ -4,7 +4,6 @@
 // any other; summary.json records the ranks and threads; a job stopped part-way resumes under
 // mpirun with each design once.
 #include <gtest/gtest.h>
-#include <stdlib.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,81 +19,22 @@
 #include <thread>
 #include <vector>
 
+#include "tests/support/mpi_runs.hpp"
 #include "tests/support/run_process.hpp"
-
-#ifndef BEAMRAIL_EXECUTABLE
-#error "BEAMRAIL_EXECUTABLE must name the beamrail binary"
-#endif
-#ifndef BEAMRAIL_MPIEXEC
-#error "BEAMRAIL_MPIEXEC must name mpirun"
-#endif
 
 namespace beamrail {
 namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
+using testing::MpiStudyTest;
 using testing::Process;
 using testing::ProcessResult;
 using testing::read_text;
-
-std::vector<std::string> split_fields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (char c : line) {
-    if (c == '"') quoted = !quoted;
-    if (c == ',' && !quoted)
-      out.emplace_back();
-    else
-      out.back() += c;
-  }
-  return out;
-}
-
-// The rows of a CSV table (header first), each without its wall_s field.
-std::vector<std::vector<std::string>> rows_without_wall(const fs::path& path) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(path);
-  std::string line;
-  long wall = -1;
-  while (std::getline(in, line)) {
-    std::vector<std::string> f = split_fields(line);
-    if (rows.empty())
-      for (size_t i = 0; i < f.size(); ++i)
-        if (f[i] == "wall_s") wall = static_cast<long>(i);
-    if (wall >= 0 && wall < static_cast<long>(f.size())) f.erase(f.begin() + wall);
-    rows.push_back(std::move(f));
-  }
-  return rows;
-}
-
-// A 1.2 m steel tube cantilever with a 3 kg tip body under a side load: static and modal
-// responses over its outer diameter and wall. A wall of 12 mm on a tube of 20 mm is more than its
-// radius: that design is invalid.
-Json tube_sweep(const Json& plan) {
-  Json s = Json::parse(R"({
-    "name": "tube_sweep",
-    "scene": {
-      "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-      "sections": {"tube": {"shape": "tube", "outer_diameter": 0.04, "wall": 0.003}},
-      "bodies": [{"name": "tip", "mass": 3.0, "inertia": [2e-3, 2e-3, 2e-3],
-                  "position": [1.2, 0, 0]}],
-      "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-                 "point2": [1.2, 0, 0], "point3": [0, 1, 0], "material": "steel",
-                 "section": "tube", "segments": 4}],
-      "loads": [{"type": "force", "body": "tip", "value": [0, -200, 0]}]
-    },
-    "analyses": [{"type": "static"}, {"type": "modal", "modes": 2, "about": "initial"}],
-    "responses": {
-      "f1": {"quantity": "frequency", "mode": 1},
-      "deflection": {"quantity": "displacement", "body": "tip", "direction": [0, -1, 0]},
-      "stress": {"quantity": "max_stress"},
-      "mass": {"quantity": "mass"}
-    }
-  })");
-  s["study"] = plan;
-  return s;
-}
+using testing::rows_without_wall;
+using testing::tube_optimization;
+using testing::tube_sweep;
+using testing::without_times;
 
 Json grid_plan() {
   return Json::parse(R"({"type": "sweep", "sampling": "grid", "variables": [
@@ -175,41 +115,8 @@ size_t lines_of(const fs::path& table) {
   return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
 }
 
-class MpiRun : public ::testing::Test {
+class MpiRun : public MpiStudyTest {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "beamrail_mpi_XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
-  fs::path write_study(const std::string& name, const Json& study) {
-    std::ofstream(dir_ / name, std::ios::binary) << study.dump(2) << "\n";
-    return dir_ / name;
-  }
-
-  // mpirun's arguments for `ranks` ranks of `beamrail args...`: more ranks than cores are
-  // allowed, threads are not bound to one core, and root may run it (CI runs as root).
-  static std::vector<std::string> mpirun_args(int ranks, const std::vector<std::string>& args) {
-    std::vector<std::string> a{"--oversubscribe", "--bind-to", "none", "-n", std::to_string(ranks)};
-    if (geteuid() == 0) a.insert(a.begin(), "--allow-run-as-root");
-    a.push_back(BEAMRAIL_EXECUTABLE);
-    a.insert(a.end(), args.begin(), args.end());
-    return a;
-  }
-
-  ProcessResult run_alone(const std::vector<std::string>& args) {
-    return testing::run_process(BEAMRAIL_EXECUTABLE, args, dir_, std::chrono::seconds(120));
-  }
-  ProcessResult run_mpi(int ranks, const std::vector<std::string>& args) {
-    return testing::run_process(BEAMRAIL_MPIEXEC, mpirun_args(ranks, args), dir_,
-                                std::chrono::seconds(120));
-  }
-
   // Runs the study in one process with -j 1 (into "alone") and under mpirun (into "mpi"), and
   // compares the tables.
   void expect_same_tables(const Json& study, int ranks, int threads) {
@@ -261,8 +168,6 @@ class MpiRun : public ::testing::Test {
     EXPECT_EQ(summary["ranks"], 2);
     return summary;
   }
-
-  fs::path dir_;
 };
 
 // 15 designs of a grid on 2 ranks, 3 of them invalid (a wall thicker than the tube's radius): the
@@ -414,31 +319,6 @@ TEST_F(MpiRun, AWorkPrecisionStudyOnThreeRanksWritesTheTableOfOneProcess) {
   EXPECT_EQ(many["runs_per_rank"][0].get<long>() + many["runs_per_rank"][1].get<long>() +
                 many["runs_per_rank"][2].get<long>(),
             6);
-}
-
-// The tube cantilever as an optimization: the lightest tube whose first frequency is at least
-// 25 Hz and whose tip deflects at most 5 mm, from 4 starts (Latin-hypercube points). A wall
-// thicker than the tube's radius is an invalid design: a row of the history with its status.
-Json tube_optimization(const std::string& algorithm, const std::string& gradient) {
-  Json plan = Json::parse(R"({"type": "optimize", "objective": {"minimize": "mass"},
-      "constraints": [{"response": "f1", ">=": 25}, {"response": "deflection", "<=": 0.005}],
-      "starts": 4, "seed": 3, "max_evaluations": 40, "variables": [
-      {"name": "outer_diameter", "pointer": "/scene/sections/tube/outer_diameter",
-       "lower": 0.02, "upper": 0.08},
-      {"name": "wall", "pointer": "/scene/sections/tube/wall", "lower": 0.001,
-       "upper": 0.02}]})");
-  plan["algorithm"] = algorithm;
-  if (!gradient.empty()) plan["gradient"] = gradient;
-  return tube_sweep(plan);
-}
-
-// summary.json without what may differ between runs of the same study: times and the ranks and
-// threads that ran it, and what each rank did.
-Json without_times(Json summary) {
-  for (const char* key : {"wall_seconds", "evaluations_per_second", "ranks", "threads",
-                          "starts_per_rank", "designs_per_rank", "scheduler_seconds"})
-    summary.erase(key);
-  return summary;
 }
 
 // A sensitivity study of the tube with its check on 3 ranks: the 4 designs of the central

@@ -80,8 +80,7 @@ int run_sweep(const Study& study, const RunSettings& settings) {
   if (outcome.kind == RunOutcome::Kind::kInterrupted)
     std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(outcome.signal)
               << ": " << report.finished << " of " << run.designs << " designs are in "
-              << table.path().string() << "; continue with: " << settings.command
-              << " --resume\n";
+              << table.path().string() << "; continue with: " << settings.command << " --resume\n";
   if (outcome.kind == RunOutcome::Kind::kOk)
     std::cout << study.name << ": " << run.designs << " designs (" << report.failed
               << " failed or invalid, " << report.with_warnings << " with warnings) in "
@@ -167,20 +166,18 @@ int run_work_precision(const Study& study, const RunSettings& settings) {
       std::cout << study.name << ": " << report.runs << " runs (" << report.failed
                 << " failed or timed out)";
       if (!report.fastest_method.empty())
-        std::cout << "; fastest within "
-                  << format_number(study.design->work_precision.target_error) << ": "
-                  << report.fastest_method << " at rtol " << format_number(report.fastest_rtol)
-                  << " in " << report.fastest_seconds << " s";
+        std::cout << "; fastest within " << format_number(study.design->work_precision.target_error)
+                  << ": " << report.fastest_method << " at rtol "
+                  << format_number(report.fastest_rtol) << " in " << report.fastest_seconds << " s";
       std::cout << " -> " << settings.output.string() << "\n";
       break;
     case RunOutcome::Kind::kInterrupted:
       if (report.in_reference)
-        std::cerr << "beamrail: " << study.name << " interrupted by "
-                  << signal_name(outcome.signal) << " in the reference run; nothing to keep\n";
+        std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(outcome.signal)
+                  << " in the reference run; nothing to keep\n";
       else
-        std::cerr << "beamrail: " << study.name << " interrupted by "
-                  << signal_name(outcome.signal) << ": " << report.runs << " of "
-                  << report.planned << " runs are in "
+        std::cerr << "beamrail: " << study.name << " interrupted by " << signal_name(outcome.signal)
+                  << ": " << report.runs << " of " << report.planned << " runs are in "
                   << (settings.output / "work_precision.csv").string()
                   << "; a work-precision study does not resume: run it again to measure them "
                      "all\n";
@@ -199,9 +196,8 @@ int run_sensitivity(const Study& study, const RunSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   const DesignEvaluator evaluator(study);
   if (!evaluator.setup_failure().empty())
-    return failed_before_designs(
-        study,
-        fail_before_designs(study, settings.output, "sensitivity", evaluator.setup_failure()));
+    return failed_before_designs(study, fail_before_designs(study, settings.output, "sensitivity",
+                                                            evaluator.setup_failure()));
   const SensitivityResult result = compute_sensitivities(study, evaluator, settings);
   const SensitivityReport report = report_sensitivity(study, settings, result, start);
   const RunOutcome& outcome = report.outcome;

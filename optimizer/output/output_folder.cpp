@@ -58,8 +58,8 @@ bool OutputFolder::acquire(const fs::path& directory, std::string* error, std::s
     const int e = errno;
     if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS) {
       // A file system without locks (some network file systems): run, but say what is missing.
-      *warning = "cannot lock " + lock.string() + " (" + std::strerror(e) + "): a second run into " +
-                 directory.string() + " would not be refused";
+      *warning = "cannot lock " + lock.string() + " (" + std::strerror(e) +
+                 "): a second run into " + directory.string() + " would not be refused";
       return true;
     }
     if (e == EWOULDBLOCK) {

@@ -23,7 +23,8 @@ BatchTable::Opened SweepTable::open() {
   for (const char* c : {"status", "warnings", "wall_s", "message"}) header.push_back(c);
   const size_t status_column = 1 + plan.variables.size() + study_.responses.size();
   std::vector<CsvRow> existing;
-  const BatchTable::Opened opened = table_.open(path(), header, settings_.resume, &existing, &error_);
+  const BatchTable::Opened opened =
+      table_.open(path(), header, settings_.resume, &existing, &error_);
   if (opened != BatchTable::Opened::kOk) return opened;
   for (const CsvRow& row : existing) {
     resumed_.insert(std::strtol(row[0].c_str(), nullptr, 10));

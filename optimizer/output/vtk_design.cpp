@@ -170,8 +170,7 @@ DesignToDraw design_to_draw(const Study& study, const DesignChoice& choice,
                       "--design " + std::to_string(choice.start) + ":" +
                           std::to_string(choice.evaluation) + ": " + file.string() +
                           " has no such row (start " + std::to_string(choice.start) + " holds " +
-                          (last > 0 ? "evaluations 1.." + std::to_string(last) : "no rows") +
-                          ")");
+                          (last > 0 ? "evaluations 1.." + std::to_string(last) : "no rows") + ")");
       design["which"] = "row";
       design["start"] = choice.start;
       design["evaluation"] = choice.evaluation;

@@ -39,8 +39,9 @@ std::string choose_design(const Study& study, bool vtk, const std::string* desig
 struct DesignToDraw {
   RunOutcome outcome;
   std::optional<Study> study;
-  nlohmann::json record;    // the "design" entry of the VTK files: which design, its values
-  std::string description;  // "the best design", "design 3", "design 2:14", "the study's own design"
+  nlohmann::json record;  // the "design" entry of the VTK files: which design, its values
+  // What the messages call it: "the best design", "design 3", "design 2:14", ...
+  std::string description;
 };
 DesignToDraw design_to_draw(const Study& study, const DesignChoice& choice,
                             const std::filesystem::path& output);

@@ -37,7 +37,7 @@ class WorkPrecisionTable {
 // failed; kInterrupted; kWriteError) and what the messages say of the runs.
 struct WorkPrecisionReport {
   RunOutcome outcome;
-  bool in_reference = false;  // kInterrupted in the reference run, before any run
+  bool in_reference = false;   // kInterrupted in the reference run, before any run
   long runs = 0, planned = 0;  // measured, of the plan
   long failed = 0;             // of them, failed or timed out
   // The fastest run within the target error (no method when none is).

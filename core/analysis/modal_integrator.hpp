@@ -35,6 +35,8 @@
 // keeps rigid and mechanism modes, which lie in the band, from making it singular); one sparse
 // LDL^T at set-up, usually one or two evaluations per stage. Their velocities are not followed.
 // Cost per stage: products with n x m matrices and one sparse solve: bodies x modes.
+// IntegratorOptions::choose_band picks the band for rtol (core/analysis/modal_band.hpp); the
+// choice is the run's one phase (summary.json method_reason).
 #pragma once
 
 #include <array>
@@ -47,6 +49,8 @@ namespace beamrail {
 
 // Largest scene the modal integrator accepts [degrees of freedom = 6 per free body].
 inline constexpr int kModalIntegratorMaxDofs = 1200;
+// Most modes a chosen band (IntegratorOptions::choose_band) asks the sparse eigensolver for.
+inline constexpr int kModalChosenBandMaxModes = 400;
 // Largest rotation of a body from the orientation it is linearized about that the method follows
 // [rad].
 inline constexpr double kModalIntegratorMaxRotation = 1.0;
@@ -58,6 +62,10 @@ inline constexpr int kModalTooFar = -20;
 // The eigenvalues w^2 of a modal integrator's linearization: the smallest positive one and the
 // largest [1/s^2]. False when `integrator` is not a modal integrator.
 bool modal_spectrum(const Integrator& integrator, double* smallest_positive, double* largest);
+
+// How a modal integrator chose its band ("band 812 Hz: 40 of 5,994 modes, ..."); "" when it was
+// given or the integrator is not modal.
+std::string modal_band_choice(const Integrator& integrator);
 
 // The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
 double modal_step_size(const Integrator& integrator);

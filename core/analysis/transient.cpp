@@ -106,6 +106,11 @@ bool IntegratorOptions::IsValid(std::string* error) const {
     return refuse(error, "max_frequency_hz must be 0 (every mode) or positive and finite");
   if (max_frequency_hz > 0.0 && !modal)
     return refuse(error, "max_frequency_hz applies to the \"modal\" and \"auto\" methods");
+  if (choose_band && max_frequency_hz > 0.0)
+    return refuse(error,
+                  "max_frequency_hz is either a frequency or chosen (choose_band), not both");
+  if (choose_band && !modal)
+    return refuse(error, "choose_band applies to the \"modal\" and \"auto\" methods");
   if (!zero_or_positive_finite(max_rotation))
     return refuse(error, "max_rotation must be 0 (the modal limit) or positive and finite");
   return true;

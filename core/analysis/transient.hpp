@@ -60,6 +60,10 @@ struct IntegratorOptions {
   // modal, auto: the band integrated [Hz]; the modes above it are quasi-static (their static
   // response kept, their dynamics dropped). 0: every mode.
   double max_frequency_hz = 0.0;
+  // modal, auto, with max_frequency_hz 0: choose the band for rtol (core/analysis/modal_band.hpp:
+  // the fewest modes whose dropped ringing is estimated within rtol of the motion; study files'
+  // "max_frequency_hz": "auto"). auto chooses it itself for large scenes.
+  bool choose_band = false;
 
   // Whether the options can run: true, or false with the first problem in *error (a tolerance
   // not positive, an order outside the method's range, an option of another method). The

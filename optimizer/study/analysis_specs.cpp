@@ -55,10 +55,17 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   io.max_step = r.positive("max_step", false).value_or(0.0);
   io.initial_step = r.positive("initial_step", false).value_or(0.0);
   io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
-  if (r.member("max_frequency_hz", false)) {
-    if (const auto f = r.positive("max_frequency_hz", false)) {
+  if (const Json* band = r.member("max_frequency_hz", false)) {
+    const bool chosen = band->is_string() && band->get<std::string>() == "auto";
+    const auto f =
+        band->is_string() ? std::optional<double>() : r.positive("max_frequency_hz", false);
+    if (band->is_string() && !chosen) {
+      r.error("max_frequency_hz", "expected a frequency [Hz] > 0 or \"auto\"");
+    } else if (chosen || f) {
       if (io.method != IntegratorMethod::kModal && io.method != IntegratorMethod::kAuto)
         r.error("max_frequency_hz", "applies to the \"modal\" and \"auto\" methods");
+      else if (chosen)
+        io.choose_band = true;
       else
         io.max_frequency_hz = *f;
     }
@@ -82,20 +89,23 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
   if (const Json* i = r.member("integrator", false))
     read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
   a.verify = r.boolean("verify", false).value_or(false);
-  // The band integrated: a frequency [Hz], or "output": half the output rate (what the samples
-  // can show). The integrator's own max_frequency_hz, when given, wins.
-  double band = -1.0;  // none; 0: "output"
+  // The band integrated: a frequency [Hz], "output": half the output rate (what the samples
+  // can show), or "auto": chosen for rtol. The integrator's own max_frequency_hz, when given,
+  // wins.
+  double band = -1.0;  // none; 0: "output"; -2: "auto"
   if (const Json* f = r.member("max_frequency_hz", false)) {
     if (f->is_string()) {
-      if (f->get<std::string>() != "output")
-        r.error("max_frequency_hz", "expected a frequency [Hz] > 0 or \"output\"");
-      else
+      if (f->get<std::string>() == "output")
         band = 0.0;  // from output_step below
+      else if (f->get<std::string>() == "auto")
+        band = -2.0;
+      else
+        r.error("max_frequency_hz", "expected a frequency [Hz] > 0, \"output\" or \"auto\"");
     } else {
       band = r.positive("max_frequency_hz", false).value_or(-1.0);
     }
     const IntegratorOptions& io = a.transient.integrator;
-    if (band >= 0.0 && io.method != IntegratorMethod::kModal &&
+    if ((band >= 0.0 || band == -2.0) && io.method != IntegratorMethod::kModal &&
         io.method != IntegratorMethod::kAuto) {
       r.error("max_frequency_hz", "applies to the \"modal\" and \"auto\" methods");
       band = -1.0;
@@ -107,7 +117,9 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
   if (!t_end) return false;
   a.transient.t_end = *t_end;
   a.transient.output_step = step.value_or(*t_end / 100.0);
-  if (band >= 0.0 && !(a.transient.integrator.max_frequency_hz > 0.0))
+  IntegratorOptions& io = a.transient.integrator;
+  if (band == -2.0 && !(io.max_frequency_hz > 0.0)) io.choose_band = true;
+  if (band >= 0.0 && !(io.max_frequency_hz > 0.0) && !io.choose_band)
     a.transient.integrator.max_frequency_hz = band > 0.0 ? band : 0.5 / a.transient.output_step;
   if (a.transient.output_step > *t_end) {
     r.error("output_step", "must not exceed t_end");

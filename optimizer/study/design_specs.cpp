@@ -320,6 +320,7 @@ void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
           std::snprintf(band, sizeof band, " band %g Hz", io.max_frequency_hz);
           method.label += band;
         }
+        if (io.choose_band) method.label += " band auto";
         if (io.linear_solver != LinearSolverKind::kAuto)
           method.label.append(io.linear_solver == LinearSolverKind::kDense ? " dense" : " sparse");
         p.methods.push_back(method);

@@ -316,11 +316,25 @@ TEST_F(BadInput, IntegratorOptionsOfAnotherMethod) {
   }
 }
 
-// A transient's band: a frequency > 0 or "output", and only for the methods that have one.
+// A transient's band: a frequency > 0, "output" or "auto", and only for the methods that have
+// one; the integrator's: a frequency or "auto".
 TEST_F(BadInput, TransientBand) {
   const std::string at = "bad.json:/analyses/0/max_frequency_hz:";
   EXPECT_TRUE(HasOnlyError(check(with("/analyses/0/max_frequency_hz", "fast")), at,
-                           "expected a frequency [Hz] > 0 or \"output\""));
+                           "expected a frequency [Hz] > 0, \"output\" or \"auto\""));
+  {
+    Json study = with("/analyses/0/max_frequency_hz", "auto");
+    study["analyses"][0]["integrator"]["method"] = "bdf";
+    EXPECT_TRUE(HasOnlyError(check(study), at, "applies to the \"modal\" and \"auto\" methods"));
+    study["analyses"][0]["integrator"]["method"] = "modal";
+    const Result chosen = check(study);
+    EXPECT_TRUE(chosen.exited && chosen.status == 0) << chosen.how << ": " << chosen.err;
+    study = base();
+    study["analyses"][0]["integrator"]["method"] = "modal";
+    study["analyses"][0]["integrator"]["max_frequency_hz"] = "output";
+    EXPECT_TRUE(HasOnlyError(check(study), "bad.json:/analyses/0/integrator/max_frequency_hz:",
+                             "expected a frequency [Hz] > 0 or \"auto\""));
+  }
   EXPECT_TRUE(HasOnlyError(check(with("/analyses/0/max_frequency_hz", -5.0)), at, "> 0"));
   Json study = with("/analyses/0/max_frequency_hz", "output");
   study["analyses"][0]["integrator"]["method"] = "dirk";

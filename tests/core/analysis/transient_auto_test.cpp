@@ -242,16 +242,36 @@ TEST(TransientAuto, HeavyDampingTakesBdf) {
   }
 }
 
-TEST(TransientAuto, BeyondTheModalLimitTakesBdf) {
+// Beyond the dense modal method's limit, auto chooses a band for rtol
+// (core/analysis/modal_band.hpp) and integrates the modes in it; when no band of the modes it may
+// ask for meets rtol, bdf.
+TEST(TransientAuto, BeyondTheModalLimitChoosesABandOrTakesBdf) {
   const int bodies = kModalIntegratorMaxDofs / kDofsPerBody + 1;
   const Model model = scene_from_json(reference_cantilever(bodies));
   const TransientRun run = run_with(model, "auto", 1e-5, 1e-5, 1e-6);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   ASSERT_EQ(run.result.phases.size(), 1u);
-  EXPECT_EQ(run.result.phases[0].method, "bdf");
-  EXPECT_NE(run.result.phases[0].reason.find("201 free bodies: beyond the modal method's limit"),
+  EXPECT_EQ(run.result.phases[0].method, "modal");
+  const std::string& why = run.result.phases[0].reason;
+  double band = 0.0;
+  int modes = 0, all = 0;
+  const size_t at = why.find("band ");
+  ASSERT_NE(at, std::string::npos) << why;
+  ASSERT_EQ(
+      std::sscanf(why.c_str() + at, "band %lf Hz chosen for rtol: %d of %d", &band, &modes, &all),
+      3)
+      << why;
+  EXPECT_EQ(all, kDofsPerBody * bodies);
+  EXPECT_GT(modes, 20);
+  EXPECT_LT(modes, 200);
+  // rtol 1e-12 asks for more than kModalChosenBandMaxModes modes.
+  const TransientRun tight = run_with(model, "auto", 1e-5, 1e-5, 1e-12);
+  ASSERT_TRUE(tight.result.ok) << tight.result.message;
+  ASSERT_EQ(tight.result.phases.size(), 1u);
+  EXPECT_EQ(tight.result.phases[0].method, "bdf");
+  EXPECT_NE(tight.result.phases[0].reason.find("no band of the 400 lowest modes"),
             std::string::npos)
-      << run.result.phases[0].reason;
+      << tight.result.phases[0].reason;
 }
 
 // Band-limited runs (max_frequency_hz) on the reference cantilever in 10 segments against the

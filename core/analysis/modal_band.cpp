@@ -1,0 +1,226 @@
+#include "core/analysis/modal_band.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace beamrail {
+namespace {
+
+constexpr int kD = kDofsPerBody;
+
+bool same_function(const TimeFunction& a, const TimeFunction& b) {
+  return a.type == b.type && a.at == b.at && a.from == b.from && a.to == b.to &&
+         a.frequency == b.frequency && a.phase == b.phase && a.t == b.t && a.v == b.v;
+}
+
+// How a load's time function changes after t0: false when it does not; else *rate (0 for a
+// jump) and *factor (its largest value).
+bool change_after(const TimeFunction& f, double t0, double* rate, double* factor) {
+  *factor = 1.0;
+  switch (f.type) {
+    case TimeFunction::Type::kConstant:
+      return false;
+    case TimeFunction::Type::kStep:
+      *rate = 0.0;
+      return f.at > t0;
+    case TimeFunction::Type::kRamp: {
+      if (f.to <= t0) return false;
+      const double kinks = f.from > t0 ? 2.0 : 1.0;
+      *rate = f.to > f.from ? kinks / (f.to - f.from) : 0.0;
+      return true;
+    }
+    case TimeFunction::Type::kHarmonic:
+      *rate = 2.0 * std::numbers::pi * std::abs(f.frequency);
+      return f.frequency != 0.0;
+    case TimeFunction::Type::kTable: {
+      // Slope changes at the knots after t0 (held outside: slope 0 before and after).
+      double kinks = 0.0, previous = 0.0;
+      *factor = 0.0;
+      for (size_t k = 0; k < f.t.size(); ++k) {
+        const double slope =
+            k + 1 < f.t.size() ? (f.v[k + 1] - f.v[k]) / (f.t[k + 1] - f.t[k]) : 0.0;
+        if (f.t[k] > t0) kinks += std::abs(slope - previous);
+        previous = slope;
+        *factor = std::max(*factor, std::abs(f.v[k]));
+      }
+      if (!(*factor > 0.0) || kinks == 0.0) return false;
+      *rate = kinks / *factor;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi,
+                       const Eigen::SparseMatrix<double>& m0,
+                       const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& shifted, double mu,
+                       const std::vector<BandExcitation>& excitations,
+                       const std::vector<int>& watched, double tolerance) {
+  const Eigen::Index total = lambda.size();
+  BandChoice choice;
+  if (total == 0) return choice;
+  const double top = lambda.cwiseAbs().maxCoeff();
+  // Rigid and mechanism modes (w^2 at rounding level or below) stay in the band.
+  Eigen::Index least = 1;
+  double lowest_positive = 0.0;
+  for (Eigen::Index i = 0; i < total; ++i) {
+    if (lambda(i) <= 1e-8 * top)
+      least = i + 1;
+    else if (lowest_positive == 0.0)
+      lowest_positive = lambda(i);
+  }
+  const Eigen::ArrayXd w = lambda.array().max(lowest_positive > 0.0 ? lowest_positive : 1.0).sqrt();
+  // The rows measured: the translations of the bodies watched, or their rotations when nothing
+  // translates.
+  std::vector<int> bodies = watched;
+  if (bodies.empty())
+    for (int b = 0; b < phi.rows() / kD; ++b) bodies.push_back(b);
+  const auto rows_of = [&](int part) {
+    std::vector<Eigen::Index> rows;
+    for (int b : bodies)
+      for (int j = 0; j < 3; ++j) rows.push_back(kD * static_cast<Eigen::Index>(b) + 3 * part + j);
+    return rows;
+  };
+  // Per excitation: the full response and each mode's part of it, weighted by how much of it
+  // rings (1 for a jump, 1 / w for a velocity, rate / w for a smooth change).
+  struct Track {
+    Eigen::VectorXd full;
+    Eigen::ArrayXd coefficients;  // of each mode in the full response
+    Eigen::ArrayXd weights;       // of each mode's ringing
+    double beyond_weight = 1.0;   // of the modes above those given
+  };
+  std::vector<Track> tracks;
+  double scale[2] = {0.0, 0.0};  // the motion's size: translations, rotations
+  for (const BandExcitation& e : excitations) {
+    Track t;
+    if (e.kind == BandExcitation::Kind::kForce) {
+      t.full = e.factor * shifted.solve(e.vector);
+      t.coefficients = e.factor * (phi.transpose() * e.vector).array() / (lambda.array() + mu);
+    } else {
+      t.full = e.vector;
+      t.coefficients = (phi.transpose() * (m0 * e.vector)).array();
+    }
+    const double w_last = w(total - 1);
+    switch (e.kind) {
+      case BandExcitation::Kind::kVelocity:
+        t.weights = 1.0 / w;
+        t.beyond_weight = 1.0 / w_last;
+        break;
+      case BandExcitation::Kind::kForce:
+        t.weights =
+            e.rate == 0.0 ? Eigen::ArrayXd::Ones(total) : Eigen::ArrayXd((e.rate / w).min(1.0));
+        t.beyond_weight = e.rate == 0.0 ? 1.0 : std::min(1.0, e.rate / w_last);
+        break;
+    }
+    const double size = e.kind == BandExcitation::Kind::kVelocity ? 1.0 / w(0) : 1.0;
+    for (int part = 0; part < 2; ++part)
+      for (Eigen::Index r : rows_of(part))
+        scale[part] = std::max(scale[part], size * std::abs(t.full(r)));
+    tracks.push_back(std::move(t));
+  }
+  const int part = scale[0] > 0.0 ? 0 : 1;
+  if (!(scale[part] > 0.0)) {  // nothing rings
+    choice.modes = std::min(least, total);
+    choice.met = true;
+    return choice;
+  }
+  const std::vector<Eigen::Index> rows = rows_of(part);
+  const Eigen::Index nr = static_cast<Eigen::Index>(rows.size());
+  // Per track and row, from the top mode down: the coherent sum of the ringing of the modes
+  // from m up (its value at the start, when every mode is in phase) and its root sum of squares
+  // (what it averages to once they have dephased, within 1 / w_m).
+  std::vector<Eigen::ArrayXXd> coherent(tracks.size()), squares(tracks.size());
+  for (size_t i = 0; i < tracks.size(); ++i) {
+    const Track& t = tracks[i];
+    // The response of the modes above those given: for a force, the static response to its
+    // part outside them, (K0 + mu M0)^-1 (F - M0 Phi Phi^T F), equal to the full response
+    // less the modes' but without that difference of two nearly equal numbers (on a
+    // 1,000-segment cantilever, K0 + mu M0 has a condition of ~1e12: the full response is
+    // good to ~1e-5 of itself, where the part sought is ~1e-7 of it).
+    const BandExcitation& e = excitations[i];
+    Eigen::VectorXd rest;
+    if (e.kind == BandExcitation::Kind::kForce)
+      rest = e.factor * shifted.solve(e.vector - m0 * (phi * (phi.transpose() * e.vector)));
+    else
+      rest = e.vector - phi * (phi.transpose() * (m0 * e.vector));
+    Eigen::ArrayXd beyond(nr);
+    for (Eigen::Index r = 0; r < nr; ++r) beyond(r) = t.beyond_weight * rest(rows[r]);
+    coherent[i].resize(nr, total + 1);
+    squares[i].resize(nr, total + 1);
+    coherent[i].col(total) = beyond;
+    squares[i].col(total) = beyond.square();
+    for (Eigen::Index k = total - 1; k >= 0; --k)
+      for (Eigen::Index r = 0; r < nr; ++r) {
+        const double ring = t.weights(k) * t.coefficients(k) * phi(rows[r], k);
+        coherent[i](r, k) = coherent[i](r, k + 1) + ring;
+        squares[i](r, k) = squares[i](r, k + 1) + ring * ring;
+      }
+  }
+  for (Eigen::Index m = least; m <= total; ++m) {
+    const bool boundary =
+        m == total || lambda(m) - lambda(m - 1) > 1e-6 * std::abs(lambda(m)) + 1e-10 * top;
+    if (!boundary) continue;
+    double dropped = 0.0;
+    for (size_t i = 0; i < tracks.size(); ++i)
+      dropped +=
+          (coherent[i].col(m).abs().min(kBandPeakOverRms * squares[i].col(m).sqrt())).maxCoeff();
+    choice.modes = m;
+    choice.estimate = dropped / scale[part];
+    if (choice.estimate <= tolerance) {
+      choice.met = true;
+      return choice;
+    }
+  }
+  return choice;
+}
+
+std::vector<int> watched_bodies(const Model& model) {
+  std::vector<int> out, all;
+  for (int k = 0; k < model.n_free(); ++k) {
+    all.push_back(k);
+    if (!model.bodies[model.free_bodies[k]].generated) out.push_back(k);
+  }
+  return out.empty() ? all : out;
+}
+
+std::vector<BandExcitation> band_excitations(const Model& model, const Data& data,
+                                             const Eigen::VectorXd& unbalanced,
+                                             const Eigen::VectorXd& velocity, double t0) {
+  std::vector<BandExcitation> out;
+  if (unbalanced.size() == model.n_dofs && unbalanced.cwiseAbs().maxCoeff() > 0.0)
+    out.push_back({BandExcitation::Kind::kForce, unbalanced, 0.0, 1.0});
+  if (velocity.size() == model.n_dofs && velocity.cwiseAbs().maxCoeff() > 0.0)
+    out.push_back({BandExcitation::Kind::kVelocity, velocity, 0.0, 1.0});
+  std::vector<int> free_index(model.bodies.size(), -1);
+  for (int k = 0; k < model.n_free(); ++k) free_index[model.free_bodies[k]] = k;
+  // Loads on one time function change together: one excitation.
+  std::vector<const TimeFunction*> functions(out.size(), nullptr);
+  for (const Load& load : model.loads) {
+    const int k = free_index[load.body];
+    double rate = 0.0, factor = 1.0;
+    if (k < 0 || !change_after(load.time, t0, &rate, &factor)) continue;
+    size_t slot = 0;
+    while (slot < out.size() && !(functions[slot] && same_function(*functions[slot], load.time)))
+      ++slot;
+    if (slot == out.size()) {
+      out.push_back(
+          {BandExcitation::Kind::kForce, Eigen::VectorXd::Zero(model.n_dofs), rate, factor});
+      functions.push_back(&load.time);
+    }
+    const Pose<double>& pose = data.pose[load.body];
+    const Vec3 value = load.follows ? Vec3(pose.A * load.value) : load.value;
+    Eigen::VectorXd& f = out[slot].vector;
+    if (load.kind == LoadKind::kForce) {
+      f.segment<3>(kD * k) += value;
+      f.segment<3>(kD * k + 3) += (pose.A * load.offset).cross(value);
+    } else {
+      f.segment<3>(kD * k + 3) += value;
+    }
+  }
+  return out;
+}
+
+}  // namespace beamrail

@@ -1,9 +1,10 @@
 // The "auto" method of the transient analysis: it chooses per scene and per phase of the run.
 //
 // - At the start, the modal exponential integrator (core/analysis/modal_integrator.hpp)
-//   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless the
-//   scene is beyond its size limit or its fastest mode is damped beyond kAutoMaxDampingRatio
-//   (damping is explicit in the modal method): then bdf, as before auto.
+//   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless its
+//   fastest mode is damped beyond kAutoMaxDampingRatio (damping is explicit in the modal method):
+//   then bdf, as before auto. From kAutoChosenBandDofs on, the modal method's band is chosen for
+//   rtol (core/analysis/modal_band.hpp); bdf when no band of the modes it may ask for meets rtol.
 // - When a body turns more than kAutoRelinearizeRotation (less after cheap relinearizations,
 //   below) from the orientation it is linearized about, the modal method is linearized again about
 //   the current state (one eigenproblem) and the run goes on; when that happens more often than
@@ -45,10 +46,10 @@ inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
 // 2.6 at 0.21, 9.3 at 0.83; the carriage of studies/carriage_two_rails.json (0.32): 2.7.
 inline constexpr double kAutoMaxDampingRatio = 0.1;
 
-// From this many degrees of freedom on (and beyond the dense modal method's limit), auto chooses
-// the modal method's band for rtol (IntegratorOptions::choose_band) unless one is given: the
-// modes whose ringing the run can show at rtol, the others quasi-static (per step ~ bodies x
-// modes instead of bodies^2). Measured in the commit that set it.
+// From this many degrees of freedom on, auto chooses the modal method's band for rtol
+// (IntegratorOptions::choose_band) unless one is given: the modes whose ringing the run can show
+// at rtol, the others quasi-static (per step ~ bodies x modes instead of bodies^2). At 600 (a
+// 100-segment cantilever, rtol 1e-6) the chosen band (77 modes) ran in 1.2 s, every mode in 1.8 s.
 inline constexpr int kAutoChosenBandDofs = 600;
 
 // The auto integrator for the system in `context`, starting at (0, y0).

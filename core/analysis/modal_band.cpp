@@ -23,10 +23,10 @@ bool change_after(const TimeFunction& f, double t0, double* rate, double* factor
       return false;
     case TimeFunction::Type::kStep:
       *rate = 0.0;
-      return f.at > t0;
+      return f.at > t0;  // a step at t0 is in the force out of balance there
     case TimeFunction::Type::kRamp: {
       if (f.to <= t0) return false;
-      const double kinks = f.from > t0 ? 2.0 : 1.0;
+      const double kinks = f.from >= t0 ? 2.0 : 1.0;
       *rate = f.to > f.from ? kinks / (f.to - f.from) : 0.0;
       return true;
     }
@@ -40,7 +40,9 @@ bool change_after(const TimeFunction& f, double t0, double* rate, double* factor
       for (size_t k = 0; k < f.t.size(); ++k) {
         const double slope =
             k + 1 < f.t.size() ? (f.v[k + 1] - f.v[k]) / (f.t[k + 1] - f.t[k]) : 0.0;
-        if (f.t[k] > t0) kinks += std::abs(slope - previous);
+        // The knots from t0 on, and the slope of the segment t0 lies in (the run starts on it).
+        if (f.t[k] >= t0 || (k + 1 < f.t.size() && f.t[k + 1] > t0))
+          kinks += f.t[k] >= t0 ? std::abs(slope - previous) : std::abs(slope);
         previous = slope;
         *factor = std::max(*factor, std::abs(f.v[k]));
       }
@@ -64,14 +66,23 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
   if (total == 0) return choice;
   const double top = lambda.cwiseAbs().maxCoeff();
   // Rigid and mechanism modes (w^2 at rounding level or below) stay in the band.
-  Eigen::Index least = 1;
+  Eigen::Index rigid = 0;
   double lowest_positive = 0.0;
   for (Eigen::Index i = 0; i < total; ++i) {
     if (lambda(i) <= 1e-8 * top)
-      least = i + 1;
+      rigid = i + 1;
     else if (lowest_positive == 0.0)
       lowest_positive = lambda(i);
   }
+  // So do the modes a harmonic load could drive near resonance (w below kBandResonanceMargin
+  // times its frequency): quasi-static, they would miss the amplification.
+  Eigen::Index least = std::max<Eigen::Index>(rigid, 1);
+  double driven = 0.0;
+  for (const BandExcitation& e : excitations)
+    if (e.harmonic) driven = std::max(driven, kBandResonanceMargin * e.rate);
+  while (least < total && lambda(least - 1) < driven * driven) ++least;
+  if (least == total && lambda(total - 1) < driven * driven) least = total + 1;  // ask for more
+  const bool complete = phi.cols() == phi.rows();  // every mode given: nothing beyond them
   const Eigen::ArrayXd w = lambda.array().max(lowest_positive > 0.0 ? lowest_positive : 1.0).sqrt();
   // The rows measured: the translations of the bodies watched, or their rotations when nothing
   // translates.
@@ -103,6 +114,10 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
       t.full = e.vector;
       t.coefficients = (phi.transpose() * (m0 * e.vector)).array();
     }
+    // The size of the motion from the elastic response only: the rigid modes' part of a force's
+    // response, F / mu, depends on the shift, not on the motion.
+    Eigen::VectorXd elastic = t.full;
+    for (Eigen::Index k = 0; k < rigid; ++k) elastic -= t.coefficients(k) * phi.col(k);
     const double w_last = w(total - 1);
     switch (e.kind) {
       case BandExcitation::Kind::kVelocity:
@@ -118,16 +133,18 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
     const double size = e.kind == BandExcitation::Kind::kVelocity ? 1.0 / w(0) : 1.0;
     for (int part = 0; part < 2; ++part)
       for (Eigen::Index r : rows_of(part))
-        scale[part] = std::max(scale[part], size * std::abs(t.full(r)));
+        scale[part] = std::max(scale[part], size * std::abs(elastic(r)));
     tracks.push_back(std::move(t));
   }
-  const int part = scale[0] > 0.0 ? 0 : 1;
-  if (!(scale[part] > 0.0)) {  // nothing rings
-    choice.modes = std::min(least, total);
+  if (!(scale[0] > 0.0) && !(scale[1] > 0.0) && least <= total) {  // nothing rings
+    choice.modes = least;
     choice.met = true;
     return choice;
   }
-  const std::vector<Eigen::Index> rows = rows_of(part);
+  // Translations, or rotations when nothing translates (a response point away from a body's
+  // centre also moves with its rotation: not in the estimate).
+  const std::vector<Eigen::Index> rows = rows_of(scale[0] > 0.0 ? 0 : 1);
+  const Eigen::Index translations = scale[0] > 0.0 ? static_cast<Eigen::Index>(rows.size()) : 0;
   const Eigen::Index nr = static_cast<Eigen::Index>(rows.size());
   // Per track and row, from the top mode down: the coherent sum of the ringing of the modes
   // from m up (its value at the start, when every mode is in phase) and its root sum of squares
@@ -146,29 +163,37 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
       rest = e.factor * shifted.solve(e.vector - m0 * (phi * (phi.transpose() * e.vector)));
     else
       rest = e.vector - phi * (phi.transpose() * (m0 * e.vector));
-    Eigen::ArrayXd beyond(nr);
-    for (Eigen::Index r = 0; r < nr; ++r) beyond(r) = t.beyond_weight * rest(rows[r]);
+    Eigen::ArrayXd beyond = Eigen::ArrayXd::Zero(nr);
+    if (!complete)
+      for (Eigen::Index r = 0; r < nr; ++r) beyond(r) = std::abs(t.beyond_weight * rest(rows[r]));
     coherent[i].resize(nr, total + 1);
     squares[i].resize(nr, total + 1);
     coherent[i].col(total) = beyond;
     squares[i].col(total) = beyond.square();
     for (Eigen::Index k = total - 1; k >= 0; --k)
       for (Eigen::Index r = 0; r < nr; ++r) {
-        const double ring = t.weights(k) * t.coefficients(k) * phi(rows[r], k);
+        const double ring = std::abs(t.weights(k) * t.coefficients(k) * phi(rows[r], k));
         coherent[i](r, k) = coherent[i](r, k + 1) + ring;
         squares[i](r, k) = squares[i](r, k + 1) + ring * ring;
       }
   }
   for (Eigen::Index m = least; m <= total; ++m) {
+    // At the last mode given, a twin not given may lie just above: only a complete basis ends
+    // there.
     const bool boundary =
-        m == total || lambda(m) - lambda(m - 1) > 1e-6 * std::abs(lambda(m)) + 1e-10 * top;
+        m == total ? complete
+                   : lambda(m) - lambda(m - 1) > 1e-6 * std::abs(lambda(m)) + 1e-10 * top;
     if (!boundary) continue;
-    double dropped = 0.0;
-    for (size_t i = 0; i < tracks.size(); ++i)
-      dropped +=
-          (coherent[i].col(m).abs().min(kBandPeakOverRms * squares[i].col(m).sqrt())).maxCoeff();
+    double dropped[2] = {0.0, 0.0};
+    for (size_t i = 0; i < tracks.size(); ++i) {
+      const Eigen::ArrayXd amplitude =
+          coherent[i].col(m).min(kBandPeakOverRms * squares[i].col(m).sqrt());
+      if (translations) dropped[0] += amplitude.head(translations).maxCoeff();
+      if (nr > translations) dropped[1] += amplitude.tail(nr - translations).maxCoeff();
+    }
     choice.modes = m;
-    choice.estimate = dropped / scale[part];
+    choice.estimate = std::max(scale[0] > 0.0 ? dropped[0] / scale[0] : 0.0,
+                               scale[1] > 0.0 ? dropped[1] / scale[1] : 0.0);
     if (choice.estimate <= tolerance) {
       choice.met = true;
       return choice;
@@ -206,8 +231,8 @@ std::vector<BandExcitation> band_excitations(const Model& model, const Data& dat
     while (slot < out.size() && !(functions[slot] && same_function(*functions[slot], load.time)))
       ++slot;
     if (slot == out.size()) {
-      out.push_back(
-          {BandExcitation::Kind::kForce, Eigen::VectorXd::Zero(model.n_dofs), rate, factor});
+      out.push_back({BandExcitation::Kind::kForce, Eigen::VectorXd::Zero(model.n_dofs), rate,
+                     factor, load.time.type == TimeFunction::Type::kHarmonic});
       functions.push_back(&load.time);
     }
     const Pose<double>& pose = data.pose[load.body];

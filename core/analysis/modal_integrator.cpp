@@ -151,7 +151,7 @@ class ModalExponential : public Integrator {
                     static_cast<long>(band_needed_), static_cast<long>(n_));
     else
       std::snprintf(text, sizeof text,
-                    "band %.4g Hz chosen for rtol: %ld of %ld modes integrated, the others "
+                    "band %.17g Hz chosen for rtol: %ld of %ld modes integrated, the others "
                     "quasi-static (their ringing estimated at %.2g of the motion)",
                     band_hz_, static_cast<long>(m_), static_cast<long>(n_), band_estimate_);
     return text;
@@ -264,15 +264,14 @@ class ModalExponential : public Integrator {
     std::vector<BandExcitation> excitations;
     const std::vector<int> watched = watched_bodies(model);
     if (choose) {
-      // The force out of balance at the initial state, at rest (what makes an offset from the
+      // The force out of balance at the initial state (what makes an offset from the
       // linearization ring; with the kinematics of the motion, unlike the offset itself, whose
       // second-order parts, such as a bent beam's shortening, follow the bending instead).
       const Data linearized = data;
       Block x;
       physical(y0, x);
       const Eigen::VectorXd velocity = x.col(1);
-      x.col(1).setZero();
-      states_of(x, y13_.data(), false);
+      states_of(x, y13_.data(), false);  // with its velocities (gyroscopic forces, damping)
       if (!accelerations(t0, x))
         return fail(error, "the modal integrator: the forces at the initial state are not finite");
       data = linearized;
@@ -374,6 +373,7 @@ class ModalExponential : public Integrator {
     m_ = static_cast<Eigen::Index>(kept.size());
     if (m_ == 0)
       return fail(error, "no mode lies below max_frequency_hz = " + std::to_string(band_hz_));
+    // (A chosen band keeps at least one mode: choose_band's least.)
     phi_.resize(n_, m_);
     for (Eigen::Index i = 0; i < m_; ++i) phi_.col(i) = vectors.col(kept[i]);
     psi_t_ = (m0_ * phi_).transpose();

@@ -10,8 +10,18 @@ template <int kVectors>
 [[gnu::always_inline]] inline void product_kernel(long n, const double* __restrict a,
                                                   const double* __restrict x,
                                                   double* __restrict y) {
-  for (long i = 0; i < kVectors * n; ++i) y[i] = 0.0;
   constexpr int kBlock = 8;
+  if (n < kBlock) {
+    // A few modes (a small scene relinearized often): the blocked loops' set-up would dominate.
+    for (int v = 0; v < kVectors; ++v)
+      for (long i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (long k = 0; k < n; ++k) s += a[k * n + i] * x[v * n + k];
+        y[v * n + i] = s;
+      }
+    return;
+  }
+  for (long i = 0; i < kVectors * n; ++i) y[i] = 0.0;
   long k = 0;
   for (; k + kBlock <= n; k += kBlock) {
     const double* col = a + k * n;

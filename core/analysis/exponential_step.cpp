@@ -52,49 +52,51 @@ std::array<double, 5> oscillator_g(double x) {
   return g;
 }
 
-ModeFunction combine(std::initializer_list<std::pair<double, const ModeFunction*>> terms) {
-  ModeFunction r(terms.begin()->second->alpha.size());
-  for (const auto& [s, f] : terms) r.add(s, *f);
-  return r;
-}
-
 void StepFunctions::compute(double step, const Eigen::ArrayXd& lambda) {
   h = step;
   const Eigen::Index n = lambda.size();
-  ModeFunction phi_h[4], phi_f[4];  // phi_k(h/2 B), phi_k(h B)
-  for (auto& f : phi_h) f = ModeFunction(n);
-  for (auto& f : phi_f) f = ModeFunction(n);
+  // Sized once (a step's functions are recomputed every step: no allocation after the first).
+  ModeFunction* used[] = {&e_half,  &e_full,  &a[1][0], &a[2][0], &a[2][1], &a[3][0], &a[3][1],
+                          &a[3][2], &a[4][0], &a[4][1], &a[4][2], &a[4][3], &b[0],    &b[3],
+                          &b[4],    &low[0],  &low[1]};
+  for (ModeFunction* f : used) {
+    f->alpha.resize(n);
+    f->beta.resize(n);
+  }
+  for (ModeFunction* f : {&b[1], &b[2]}) *f = ModeFunction();  // zero: skipped
+  // Per mode, phi_k(h/2 B) (ph) and phi_k(h B) (pf), k = 0..3, for alpha (part 0) and beta
+  // (part 1), combined as the method's coefficients.
   for (Eigen::Index i = 0; i < n; ++i) {
-    for (int half = 0; half < 2; ++half) {
-      const double tau = half ? 0.5 * h : h;
-      const std::array<double, 5> g = oscillator_g(lambda(i) * tau * tau);
-      ModeFunction* phi = half ? phi_h : phi_f;
+    const std::array<double, 5> gh = oscillator_g(lambda(i) * (0.5 * h) * (0.5 * h));
+    const std::array<double, 5> gf = oscillator_g(lambda(i) * h * h);
+    for (int part = 0; part < 2; ++part) {
+      double ph[4], pf[4];
       for (int k = 0; k < 4; ++k) {
-        phi[k].alpha(i) = g[k];
-        phi[k].beta(i) = tau * g[k + 1];
+        ph[k] = part ? 0.5 * h * gh[k + 1] : gh[k];
+        pf[k] = part ? h * gf[k + 1] : gf[k];
       }
+      const auto set = [part, i](ModeFunction& f, double v) { (part ? f.beta : f.alpha)(i) = v; };
+      set(e_half, ph[0]);
+      set(e_full, pf[0]);
+      set(a[1][0], 0.5 * ph[1]);
+      set(a[2][0], 0.5 * ph[1] - ph[2]);
+      set(a[2][1], ph[2]);
+      set(a[3][0], pf[1] - 2.0 * pf[2]);
+      set(a[3][1], pf[2]);
+      set(a[3][2], pf[2]);
+      const double a41 = 0.5 * ph[2] - pf[3] + 0.25 * pf[2] - 0.5 * ph[3];
+      const double a43 = 0.25 * ph[2] - a41;
+      set(a[4][1], a41);
+      set(a[4][2], a41);
+      set(a[4][3], a43);
+      set(a[4][0], 0.5 * ph[1] - 2.0 * a41 - a43);
+      set(b[0], pf[1] - 3.0 * pf[2] + 4.0 * pf[3]);
+      set(b[3], -pf[2] + 4.0 * pf[3]);
+      set(b[4], 4.0 * pf[2] - 8.0 * pf[3]);
+      set(low[0], pf[1] - 2.0 * pf[2]);
+      set(low[1], 2.0 * pf[2]);
     }
   }
-  e_half = phi_h[0];
-  e_full = phi_f[0];
-  for (auto& row : a)
-    for (auto& f : row) f = ModeFunction();
-  a[1][0] = combine({{0.5, &phi_h[1]}});
-  a[2][0] = combine({{0.5, &phi_h[1]}, {-1.0, &phi_h[2]}});
-  a[2][1] = phi_h[2];
-  a[3][0] = combine({{1.0, &phi_f[1]}, {-2.0, &phi_f[2]}});
-  a[3][1] = phi_f[2];
-  a[3][2] = phi_f[2];
-  a[4][1] = combine({{0.5, &phi_h[2]}, {-1.0, &phi_f[3]}, {0.25, &phi_f[2]}, {-0.5, &phi_h[3]}});
-  a[4][2] = a[4][1];
-  a[4][3] = combine({{0.25, &phi_h[2]}, {-1.0, &a[4][1]}});
-  a[4][0] = combine({{0.5, &phi_h[1]}, {-2.0, &a[4][1]}, {-1.0, &a[4][3]}});
-  b[0] = combine({{1.0, &phi_f[1]}, {-3.0, &phi_f[2]}, {4.0, &phi_f[3]}});
-  b[1] = b[2] = ModeFunction();
-  b[3] = combine({{-1.0, &phi_f[2]}, {4.0, &phi_f[3]}});
-  b[4] = combine({{4.0, &phi_f[2]}, {-8.0, &phi_f[3]}});
-  low[0] = combine({{1.0, &phi_f[1]}, {-2.0, &phi_f[2]}});
-  low[1] = combine({{2.0, &phi_f[2]}});
 }
 
 }  // namespace beamrail

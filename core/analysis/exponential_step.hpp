@@ -5,8 +5,6 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <initializer_list>
-#include <utility>
 
 namespace beamrail {
 
@@ -24,22 +22,14 @@ struct ModeFunction {
   ModeFunction() = default;
   explicit ModeFunction(Eigen::Index n) : alpha(Eigen::ArrayXd::Zero(n)), beta(alpha) {}
   bool empty() const { return alpha.size() == 0; }  // a zero coefficient: skipped
-  ModeFunction& add(double s, const ModeFunction& f) {
-    alpha += s * f.alpha;
-    beta += s * f.beta;
-    return *this;
-  }
 };
 
-// The sum of s f over the terms (s, f).
-ModeFunction combine(std::initializer_list<std::pair<double, const ModeFunction*>> terms);
-
-// out += f(B) z, per mode (inline: every stage of every step calls it).
+// out += s f(B) z, per mode (inline: every stage of every step calls it).
 inline void apply_add(const ModeFunction& f, const Eigen::ArrayXd& lambda, const ModeBlock& z,
-                      ModeBlock& out) {
+                      ModeBlock& out, double s = 1.0) {
   const auto a = z.col(0).array(), b = z.col(1).array();
-  out.col(0).array() += f.alpha * a + f.beta * b;
-  out.col(1).array() += f.alpha * b - f.beta * lambda * a;
+  out.col(0).array() += s * (f.alpha * a + f.beta * b);
+  out.col(1).array() += s * (f.alpha * b - f.beta * lambda * a);
 }
 
 // The coefficient functions of one step of size h of the stiff-order-4 exponential Runge-Kutta

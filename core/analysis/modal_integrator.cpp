@@ -84,6 +84,7 @@ class ModalExponential : public Integrator {
     c0_.resize(model.n_free());
     a0_.resize(model.n_free());
     q0_.resize(model.n_free());
+    orientation_.resize(model.n_free());
     for (int b = 0; b < model.n_free(); ++b) {
       const double* r = reference.data() + kS * b;
       c0_[b] = Vec3(r[0], r[1], r[2]);
@@ -483,7 +484,7 @@ class ModalExponential : public Integrator {
       }
       Vec4 q = quat_multiply(quat_from_rotation_vector(theta), q0_[b]);
       q /= q.norm();
-      const Mat3 a = rotation_matrix<double>(q);
+      const Mat3& a = orientation_[b] = rotation_matrix<double>(q);
       const Vec3 c = c0_[b] + x.block<3, 1>(kD * b, 0);
       const Vec3 w = a.transpose() * angular_velocity(theta, x.block<3, 1>(kD * b + 3, 1));
       for (int j = 0; j < 3; ++j) {
@@ -500,16 +501,15 @@ class ModalExponential : public Integrator {
   void to_states(double* y) { states_of(x_, y, false); }
 
   // The accelerations (dv/dt, d^2 theta/dt^2) into acceleration_ at the physical state x whose
-  // 13 states are in y13_; false when they are not finite.
+  // 13 states states_of has just written into y13_; false when they are not finite.
   bool accelerations(double t, const Block& x) {
     state_derivative(context_->model, context_->data, t, y13_.data(), ydot13_.data());
     ++stats_.rhs_evaluations;
     for (size_t b = 0; b < c0_.size(); ++b) {
-      const double* s = y13_.data() + kS * b;
       const double* d = ydot13_.data() + kS * b;
       for (int j = 0; j < kS; ++j)
         if (!std::isfinite(d[j])) return false;
-      const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
+      const Mat3& a = orientation_[b];  // of the quaternion in y13_
       acceleration_.segment<3>(kD * b) = Vec3(d[7], d[8], d[9]);
       acceleration_.segment<3>(kD * b + 3) =
           rotation_vector_acceleration(x.block<3, 1>(kD * b + 3, 0), x.block<3, 1>(kD * b + 3, 1),
@@ -576,20 +576,21 @@ class ModalExponential : public Integrator {
     constexpr int s = StepFunctions::kStages;
     stage_n_[0] = n0;
     for (int i = 1; i < s; ++i) {
-      Block zi = Block::Zero(m_, 2);
-      apply_add(StepFunctions::c[i] == 1.0 ? f.e_full : f.e_half, lambda_, z, zi);
+      stage_z_.setZero(m_, 2);
+      apply_add(StepFunctions::c[i] == 1.0 ? f.e_full : f.e_half, lambda_, z, stage_z_);
       for (int j = 0; j < i; ++j) {
         if (f.a[i][j].empty()) continue;
-        apply_add(f.a[i][j], lambda_, f.h * stage_n_[j], zi);
+        apply_add(f.a[i][j], lambda_, stage_n_[j], stage_z_, f.h);
       }
-      multiply(phi_, zi, xi_);
+      multiply(phi_, stage_z_, xi_);
       if (reduced_) xi_.col(0) += y_;
-      if (!nonlinear(t + StepFunctions::c[i] * f.h, zi, xi_, stage_n_[i], flag)) return false;
+      if (!nonlinear(t + StepFunctions::c[i] * f.h, stage_z_, xi_, stage_n_[i], flag))
+        return false;
     }
-    out = Block::Zero(m_, 2);
+    out.setZero(m_, 2);
     apply_add(f.e_full, lambda_, z, out);
     for (int j = 0; j < s; ++j)
-      if (!f.b[j].empty()) apply_add(f.b[j], lambda_, f.h * stage_n_[j], out);
+      if (!f.b[j].empty()) apply_add(f.b[j], lambda_, stage_n_[j], out, f.h);
     return true;
   }
 
@@ -642,7 +643,7 @@ class ModalExponential : public Integrator {
       if (!have_n0_ && !nonlinear(t_, z_, x_, n0_, &flag)) return fail_flag(flag);
       have_n0_ = true;
       const Block& n0 = n0_;
-      const Eigen::VectorXd y_start = y_;  // the quasi-static part at the accepted state
+      if (reduced_) y_start_ = y_;  // the quasi-static part at the accepted state
       if (h_ <= 0.0) h_ = options_.initial_step > 0.0 ? options_.initial_step : (target - t_);
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
@@ -651,8 +652,8 @@ class ModalExponential : public Integrator {
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
         full_.compute(h, lambda_);
-        if (reduced_) y_ = y_start;  // not a rejected trial's
-        Block next;
+        if (reduced_) y_ = y_start_;  // not a rejected trial's
+        Block& next = next_;
         int sflag = kOk;
         const bool ok = step(full_, t_, z_, n0, next, &sflag);
         double err = 0.0;
@@ -661,14 +662,17 @@ class ModalExponential : public Integrator {
           // The distance to the embedded third-order solution, h b5 (N5 - N3), and to the
           // embedded second-order one from stages 1 and 2 against rtol^(3/4) (both then ask for
           // steps ~ rtol^(1/4)).
-          Block difference = Block::Zero(m_, 2);
-          apply_add(full_.b[4], lambda_, h * (stage_n_[4] - stage_n_[2]), difference);
+          Block& difference = difference_;
+          difference.setZero(m_, 2);
+          apply_add(full_.b[4], lambda_, stage_n_[4], difference, h);
+          apply_add(full_.b[4], lambda_, stage_n_[2], difference, -h);
           err = error_norm(difference, x_next_) / kToleranceScale;
-          Block low = Block::Zero(m_, 2);
-          apply_add(full_.e_full, lambda_, z_, low);
-          apply_add(full_.low[0], lambda_, h * stage_n_[0], low);
-          apply_add(full_.low[1], lambda_, h * stage_n_[1], low);
-          err = std::max(err, error_norm(next - low, x_next_) * low_order_weight_);
+          // next - low, low the embedded second-order solution.
+          difference = next;
+          apply_add(full_.e_full, lambda_, z_, difference, -1.0);
+          apply_add(full_.low[0], lambda_, stage_n_[0], difference, -h);
+          apply_add(full_.low[1], lambda_, stage_n_[1], difference, -h);
+          err = std::max(err, error_norm(difference, x_next_) * low_order_weight_);
           if (!std::isfinite(err)) err = 1e10;
         } else if (sflag == kNonFinite) {
           // Perhaps a trial state too far out: retry smaller before giving up.
@@ -685,7 +689,7 @@ class ModalExponential : public Integrator {
         }
         if (err <= 1.0) {
           t_ = (h == target - t_) ? target : t_ + h;
-          z_ = next;
+          z_.swap(next);
           x_.swap(x_next_);
           if (reduced_) x_.col(0) += y_;
           have_n0_ = false;
@@ -744,6 +748,9 @@ class ModalExponential : public Integrator {
   std::vector<Mat3> a0_;
   Block z_, x_;                   // the accepted state, modal and physical (x_ = Phi z_)
   Block xi_, x_next_, e_;         // work space: a stage's physical state, a trial step's, its error
+  Block stage_z_, next_, difference_;  // work space: a stage's modal state, a trial step, errors
+  Eigen::VectorXd y_start_;              // work space: the quasi-static part at the accepted state
+  std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote
   Eigen::VectorXd acceleration_;  // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;
   double t0_ = 0.0;  // where the run started

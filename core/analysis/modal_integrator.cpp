@@ -27,13 +27,19 @@ constexpr int kS = kStatesPerBody;
 
 using Block = ModeBlock;
 
-// out = a b (a change of basis of both columns).
+// out = a b (a change of basis of both columns; a is n x n, or a band's n x m basis or its
+// transpose).
 void multiply(const Eigen::MatrixXd& a, const Block& b, Block& out) {
   out.resize(a.rows(), 2);
-  if (a.rows() == a.cols())
-    multiply_pair(a, b.data(), out.data());
-  else
-    out.noalias() = a * b;  // a reduced basis (n x m) or its transpose
+  multiply_pair(a, b.data(), out.data());
+}
+
+// out -= a b for a vector b (one pass over a; work: a.rows() doubles of work space).
+void subtract_product(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, Eigen::VectorXd& work,
+                      Eigen::VectorXd& out) {
+  work.resize(a.rows());
+  multiply_vector(a, b.data(), work.data());
+  out -= work;
 }
 
 // "1 rad" for messages.
@@ -404,11 +410,13 @@ class ModalExponential : public Integrator {
     Eigen::VectorXd dy = k0_.solve(work_n_);
     if (updated_) {
       // With the tangent K of a later state: dy = K^-1 (M0 a - Psi l), Psi^T dy = 0.
-      work_m_ = schur_.solve(psi_t_ * dy);
-      dy.noalias() -= kinv_psi_ * work_m_;
+      psi_a_work_.resize(m_);
+      multiply_vector(psi_t_, dy.data(), psi_a_work_.data());
+      work_m_ = schur_.solve(psi_a_work_);
+      subtract_product(kinv_psi_, work_m_, work_n_, dy);
     } else {
       work_m_ = psi_a.array() / (lambda_ + shift_);
-      dy.noalias() -= phi_ * work_m_;
+      subtract_product(phi_, work_m_, work_n_, dy);
     }
     y_ += dy;
     x.col(0) += dy;
@@ -538,7 +546,8 @@ class ModalExponential : public Integrator {
         multiply_vector(psi_t_, acceleration_.data(), out.col(1).data());
         break;
       }
-      psi_a_.noalias() = psi_t_ * acceleration_;
+      psi_a_.resize(m_);
+      multiply_vector(psi_t_, acceleration_.data(), psi_a_.data());
       // Quasi-static outside the band: corrected until the correction is a small part of the
       // tolerance (the accelerations of the last evaluation are kept).
       const double size = correct(psi_a_, x);
@@ -733,7 +742,7 @@ class ModalExponential : public Integrator {
   Eigen::MatrixXd kinv_psi_;  // K^-1 Psi
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_;  // of Psi^T K^-1 Psi
   Eigen::VectorXd y_;                           // the quasi-static part of the latest evaluation
-  Eigen::VectorXd work_n_, work_m_, psi_a_;
+  Eigen::VectorXd work_n_, work_m_, psi_a_, psi_a_work_;
   Block n0_;  // N at the accepted state, when have_n0_
   bool have_n0_ = false;
   double band_hz_ = 0.0;          // the highest frequency integrated [Hz]

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+
+#include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/modal_integrator.hpp"
 
 namespace beamrail {
 namespace {
@@ -246,6 +250,120 @@ std::vector<BandExcitation> band_excitations(const Model& model, const Data& dat
     }
   }
   return out;
+}
+
+namespace {
+
+bool band_fail(std::string* error, const std::string& what) {
+  *error = what;
+  return false;
+}
+
+}  // namespace
+
+bool solve_band_modes(const Model& model, const Data& data, double t0,
+                      const Eigen::SparseMatrix<double>& k0, const Eigen::SparseMatrix<double>& m0,
+                      double band_hz, const std::vector<BandExcitation>& excitations,
+                      const std::vector<int>& watched, double rtol, double max_seconds,
+                      BandModes& out, std::string* error) {
+  const bool choose = !(band_hz > 0.0);
+  double limit = choose ? 0.0 : std::pow(2.0 * std::numbers::pi * band_hz, 2);
+  const Eigen::Index n = model.n_dofs;
+  const double seconds = max_seconds;
+  Eigen::VectorXd& values = out.values;
+  Eigen::MatrixXd& vectors = out.vectors;
+  out = BandModes();
+  BandChoice chosen;
+  const auto estimate = [&]() {
+    // A shift of a hundredth of the lowest positive w^2 keeps rigid and mechanism modes
+    // regular (they are kept).
+    const double top = values.cwiseAbs().maxCoeff();
+    double mu = 0.0;
+    for (Eigen::Index i = 0; i < values.size() && mu == 0.0; ++i)
+      if (values(i) > 1e-8 * top) mu = 0.01 * values(i);
+    if (mu == 0.0) mu = 1.0;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> shifted(
+        Eigen::SparseMatrix<double>(k0 + mu * m0));
+    if (shifted.info() != Eigen::Success) return false;
+    chosen = choose_band(values, vectors, m0, shifted, mu, excitations, watched, rtol);
+    return true;
+  };
+  if (n <= kModalIntegratorMaxDofs) {
+    if (!solve_dense_eigenproblem(Eigen::MatrixXd(k0), Eigen::MatrixXd(m0), values, vectors))
+      return band_fail(error, "the modal integrator's eigensolver failed");
+    if (choose && !estimate())
+      return band_fail(error,
+                       "the modal integrator: the stiffness where it is linearized is singular");
+  } else {
+    ModalOptions mo;
+    mo.time = t0;
+    mo.solver = EigenSolverKind::kShiftInvert;
+    const int most =
+        static_cast<int>(std::min<Eigen::Index>(n - 12, choose ? kModalChosenBandMaxModes : n));
+    for (int wanted = std::min(24, most);; wanted = std::min(2 * wanted, most)) {
+      mo.modes = wanted;
+      if (seconds < 1e7) mo.max_seconds = std::max(1e-3, seconds);
+      Data d = data;
+      const ModalResult r = solve_modal(model, mo, d);
+      if (!r.ok) return band_fail(error, "the modal integrator's eigensolver: " + r.message);
+      std::vector<size_t> order(r.modes.size());
+      for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+        return r.modes[a].eigenvalue < r.modes[b].eigenvalue;
+      });
+      values.resize(static_cast<Eigen::Index>(order.size()));
+      vectors.resize(n, values.size());
+      for (Eigen::Index i = 0; i < values.size(); ++i) {
+        values(i) = r.modes[order[i]].eigenvalue;
+        vectors.col(i) = r.modes[order[i]].shape;
+      }
+      const bool all = wanted >= most;
+      if (choose) {
+        if (!estimate())
+          return band_fail(
+              error, "the modal integrator: the stiffness where it is linearized is singular");
+        if (chosen.met || all) break;
+      } else if ((values.size() && values(values.size() - 1) > limit) || all) {
+        break;
+      }
+    }
+  }
+  if (choose) {
+    if (!chosen.met) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "no band of the %ld lowest modes (up to %.4g Hz) keeps the ringing of the "
+                    "modes above it within rtol (%.2g of the motion estimated for all %ld)",
+                    static_cast<long>(values.size()),
+                    std::sqrt(std::max(0.0, values(values.size() - 1))) / (2.0 * std::numbers::pi),
+                    chosen.estimate, static_cast<long>(values.size()));
+      return band_fail(error, text);
+    }
+    // Beyond half the modes, the products with n x m matrices and the quasi-static iteration
+    // cost more than the full basis's n x n products: all modes then (exact, no band).
+    const bool all = n <= kModalIntegratorMaxDofs && 2 * chosen.modes > n;
+    out.kept = all ? n : chosen.modes;
+    out.needed = chosen.modes;
+    if (all) {
+      chosen.modes = n;
+      chosen.estimate = 0.0;
+    }
+    // The band's top: the highest mode kept, or the lowest elastic one when only rigid and
+    // mechanism modes are (the shift below must not vanish).
+    const double top = values.cwiseAbs().maxCoeff();
+    limit = values(chosen.modes - 1);
+    for (Eigen::Index i = 0; i < values.size() && !(limit > 1e-8 * top); ++i)
+      limit = std::max(limit, values(i));
+    out.estimate = chosen.estimate;
+  } else {
+    out.kept = 0;
+    while (out.kept < values.size() && values(out.kept) <= limit) ++out.kept;
+  }
+  out.top = limit;
+  if (out.kept == 0)
+    return band_fail(error, "no mode lies below max_frequency_hz = " + std::to_string(band_hz));
+  // (A chosen band keeps at least one mode: choose_band's least.)
+  return true;
 }
 
 }  // namespace beamrail

@@ -39,6 +39,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <string>
 #include <vector>
 
 #include "core/model/data.hpp"
@@ -91,5 +92,27 @@ std::vector<int> watched_bodies(const Model& model);
 std::vector<BandExcitation> band_excitations(const Model& model, const Data& data,
                                              const Eigen::VectorXd& unbalanced,
                                              const Eigen::VectorXd& velocity, double t0);
+
+// The modes of a band-limited run (core/analysis/modal_integrator.hpp): from the dense eigensolver
+// up to kModalIntegratorMaxDofs degrees of freedom, else from shift-invert Lanczos asked for more
+// modes until one lies above the band or, for a band chosen for rtol (band_hz 0), until the band
+// meets rtol (at most kModalChosenBandMaxModes modes). k0 and m0: the symmetric tangent stiffness
+// and the mass of the linearization posed in `data`; `excitations` and `watched` as for
+// choose_band (only for a chosen band). False with *error when the eigensolver fails, the
+// stiffness is singular, no band meets rtol, or no mode lies below a given band.
+struct BandModes {
+  Eigen::VectorXd values;   // w^2 of the modes computed, ascending
+  Eigen::MatrixXd vectors;  // their M0-normalized shapes, n x values.size()
+  Eigen::Index kept = 0;    // the lowest `kept` modes are integrated
+  double top = 0.0;         // the band's top w^2: the highest mode kept (at least the lowest
+                            // elastic one) or the given band's
+  Eigen::Index needed = 0;  // a chosen band: the modes rtol needs (kept may be all of them)
+  double estimate = -1.0;   // a chosen band: its estimate (0 when every mode is kept); -1: given
+};
+bool solve_band_modes(const Model& model, const Data& data, double t0,
+                      const Eigen::SparseMatrix<double>& k0, const Eigen::SparseMatrix<double>& m0,
+                      double band_hz, const std::vector<BandExcitation>& excitations,
+                      const std::vector<int>& watched, double rtol, double max_seconds,
+                      BandModes& out, std::string* error);
 
 }  // namespace beamrail

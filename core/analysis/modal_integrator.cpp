@@ -264,7 +264,6 @@ class ModalExponential : public Integrator {
   bool band_limited_basis(const Model& model, Data& data, double t0, const double* y0,
                           std::string* error) {
     const bool choose = !(band_hz_ > 0.0);
-    double limit = choose ? 0.0 : std::pow(2.0 * M_PI * band_hz_, 2);
     Eigen::SparseMatrix<double> k0 = -stiffness_matrix(model, data);
     k0 = 0.5 * Eigen::SparseMatrix<double>(k0 + Eigen::SparseMatrix<double>(k0.transpose()));
     m0_ = mass_matrix(model, data);
@@ -284,105 +283,22 @@ class ModalExponential : public Integrator {
       data = linearized;
       excitations = band_excitations(model, data, m0_ * acceleration_, velocity, t0);
     }
-    Eigen::VectorXd values;   // ascending
-    Eigen::MatrixXd vectors;  // M0-normalized
-    BandChoice chosen;
-    const auto estimate = [&]() {
-      // A shift of a hundredth of the lowest positive w^2 keeps rigid and mechanism modes
-      // regular (they are kept).
-      const double top = values.cwiseAbs().maxCoeff();
-      double mu = 0.0;
-      for (Eigen::Index i = 0; i < values.size() && mu == 0.0; ++i)
-        if (values(i) > 1e-8 * top) mu = 0.01 * values(i);
-      if (mu == 0.0) mu = 1.0;
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> shifted(
-          Eigen::SparseMatrix<double>(k0 + mu * m0_));
-      if (shifted.info() != Eigen::Success) return false;
-      chosen = choose_band(values, vectors, m0_, shifted, mu, excitations, watched, options_.rtol);
-      return true;
-    };
-    if (n_ <= kModalIntegratorMaxDofs) {
-      if (!solve_dense_eigenproblem(Eigen::MatrixXd(k0), Eigen::MatrixXd(m0_), values, vectors))
-        return fail(error, "the modal integrator's eigensolver failed");
-      if (choose && !estimate())
-        return fail(error,
-                    "the modal integrator: the stiffness where it is linearized is singular");
-    } else {
-      ModalOptions mo;
-      mo.time = t0;
-      mo.solver = EigenSolverKind::kShiftInvert;
-      const double seconds =
-          std::chrono::duration<double>(context_->deadline - std::chrono::steady_clock::now())
-              .count();
-      const int most =
-          static_cast<int>(std::min<Eigen::Index>(n_ - 12, choose ? kModalChosenBandMaxModes : n_));
-      for (int wanted = std::min(24, most);; wanted = std::min(2 * wanted, most)) {
-        mo.modes = wanted;
-        if (seconds < 1e7) mo.max_seconds = std::max(1e-3, seconds);
-        Data d = data;
-        const ModalResult r = solve_modal(model, mo, d);
-        if (!r.ok) return fail(error, "the modal integrator's eigensolver: " + r.message);
-        std::vector<size_t> order(r.modes.size());
-        for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-          return r.modes[a].eigenvalue < r.modes[b].eigenvalue;
-        });
-        values.resize(static_cast<Eigen::Index>(order.size()));
-        vectors.resize(n_, values.size());
-        for (Eigen::Index i = 0; i < values.size(); ++i) {
-          values(i) = r.modes[order[i]].eigenvalue;
-          vectors.col(i) = r.modes[order[i]].shape;
-        }
-        const bool all = wanted >= most;
-        if (choose) {
-          if (!estimate())
-            return fail(error,
-                        "the modal integrator: the stiffness where it is linearized is singular");
-          if (chosen.met || all) break;
-        } else if ((values.size() && values(values.size() - 1) > limit) || all) {
-          break;
-        }
-      }
-    }
-    std::vector<Eigen::Index> kept;
+    const double seconds =
+        std::chrono::duration<double>(context_->deadline - std::chrono::steady_clock::now())
+            .count();
+    BandModes band;
+    if (!solve_band_modes(model, data, t0, k0, m0_, choose ? 0.0 : band_hz_, excitations, watched,
+                          options_.rtol, seconds, band, error))
+      return false;
+    m_ = band.kept;
+    const double limit = band.top;
     if (choose) {
-      if (!chosen.met) {
-        char text[200];
-        std::snprintf(text, sizeof text,
-                      "no band of the %ld lowest modes (up to %.4g Hz) keeps the ringing of the "
-                      "modes above it within rtol (%.2g of the motion estimated for all %ld)",
-                      static_cast<long>(values.size()),
-                      std::sqrt(std::max(0.0, values(values.size() - 1))) / (2.0 * M_PI),
-                      chosen.estimate, static_cast<long>(values.size()));
-        return fail(error, text);
-      }
-      // Beyond half the modes, the products with n x m matrices and the quasi-static iteration
-      // cost more than the full basis's n x n products: all modes then (exact, no band).
-      const bool all = n_ <= kModalIntegratorMaxDofs && 2 * chosen.modes > n_;
-      for (Eigen::Index i = 0; i < (all ? n_ : chosen.modes); ++i) kept.push_back(i);
-      band_needed_ = chosen.modes;
-      if (all) {
-        chosen.modes = n_;
-        chosen.estimate = 0.0;
-      }
-      // The band's top: the highest mode kept, or the lowest elastic one when only rigid and
-      // mechanism modes are (the shift below must not vanish).
-      const double top = values.cwiseAbs().maxCoeff();
-      limit = values(chosen.modes - 1);
-      for (Eigen::Index i = 0; i < values.size() && !(limit > 1e-8 * top); ++i)
-        limit = std::max(limit, values(i));
       band_hz_ = std::sqrt(limit) / (2.0 * M_PI);
-      band_estimate_ = chosen.estimate;
-    } else {
-      for (Eigen::Index i = 0; i < values.size(); ++i)
-        if (values(i) <= limit) kept.push_back(i);
+      band_needed_ = band.needed;
+      band_estimate_ = band.estimate;
     }
-    m_ = static_cast<Eigen::Index>(kept.size());
-    if (m_ == 0)
-      return fail(error, "no mode lies below max_frequency_hz = " + std::to_string(band_hz_));
-    // (A chosen band keeps at least one mode: choose_band's least.)
-    phi_.resize(n_, m_);
-    for (Eigen::Index i = 0; i < m_; ++i) phi_.col(i) = vectors.col(kept[i]);
+    const Eigen::MatrixXd& vectors = band.vectors;
+    phi_ = vectors.leftCols(m_);
     psi_t_ = (m0_ * phi_).transpose();
     // The eigenvalues as Rayleigh quotients of this K0 (the static correction's).
     lambda_.resize(m_);

@@ -11,6 +11,7 @@
 #include "core/analysis/deadline.hpp"
 #include "core/analysis/deformation_check.hpp"
 #include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/static_newton.hpp"
 #include "core/model/element_kinematics.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
@@ -19,417 +20,7 @@ namespace beamrail {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-// Load steps in a row, each half the last, that may find "no equilibrium" before the analysis
-// gives up with it.
-constexpr int kNoEquilibriumRetries = 4;
-
-std::string format(const char* pattern, double a, double b = 0.0) {
-  char text[400];
-  std::snprintf(text, sizeof text, pattern, a, b);
-  return text;
-}
-
-// The load scale: the largest applied force (moments / length) or weight, at full load.
-double reference_force(const Model& model, double t, double length) {
-  double f = 0.0;
-  for (int i : model.free_bodies)
-    f = std::max(f, model.bodies[i].mass * model.gravity.stableNorm());
-  for (const Load& load : model.loads) {
-    const double v = std::abs(load.time(t)) * load.value.stableNorm();
-    f = std::max(f, load.kind == LoadKind::kForce ? v : v / length);
-  }
-  return f;
-}
-
-double scaled_norm(const Eigen::VectorXd& w, double length) {
-  double n = 0.0;
-  for (Eigen::Index i = 0; i < w.size(); ++i)
-    n = std::max(n, std::abs(w(i)) / ((i % kDofsPerBody) < 3 ? 1.0 : length));
-  return n;
-}
-
-// Size of a motion in metres (rotations times the characteristic length).
-double motion_size(const Eigen::VectorXd& x, double length) {
-  double sum = 0.0;
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    const double v = (i % kDofsPerBody) < 3 ? x(i) : x(i) * length;
-    sum += v * v;
-  }
-  return std::sqrt(sum);
-}
-
-// The displacement of every free body from the initial configuration (u, rotation vector).
-Eigen::VectorXd displacement(const Model& model, const Data& data) {
-  Eigen::VectorXd x(model.n_dofs);
-  for (int k = 0; k < model.n_free(); ++k) {
-    const int i = model.free_bodies[k];
-    x.segment<3>(kDofsPerBody * k) = data.pose[i].u;
-    x.segment<3>(kDofsPerBody * k + 3) = data.rotation[i];
-  }
-  return x;
-}
-
-// The smallest ratio of KLU's pivots (rcond) that is still a stiffness rather than a direction
-// without one. 1e-8 for a compact structure. A chain of n elements in series has physical pivot
-// ratios down to about 1 / (4 n^3) (the stiffness of an n-segment cantilever at its tip against
-// that of one segment: a 512-chord bend has 2e-9), so a structure whose every body is held by
-// beams (no mechanism is possible) accepts pivots down to 1e-8 / n^3, with n its total element
-// length over its shortest element, but not below 1e-14, where rounding begins; a structure that
-// is not held may be a mechanism (a free carriage: 1e-10), and keeps 1e-8.
-double pivot_floor(const Model& model) {
-  if (!held_by_beams(model)) return 1e-8;
-  double total = 0.0, shortest = INFINITY;
-  for (const Beam& e : model.beams) {
-    total += e.ends.length;
-    shortest = std::min(shortest, e.ends.length);
-  }
-  const double n = shortest > 0.0 && std::isfinite(total / shortest) ? total / shortest : 1.0;
-  return std::max(1e-8 / std::pow(std::max(n, 1.0), 3), 1e-14);
-}
-
-// A factorized tangent. KLU factors it with the symbolic analysis of the topology's velocity-level
-// pattern (6 x 6 per coupled body pair: exactly the tangent's), shared between designs. Falls back
-// to the minimum-norm solution of a dense decomposition when KLU's factors are unsound (free
-// mechanisms, or a tangent whose entries span too many decades for its pivot test). That one sees
-// the tangent equilibrated by its diagonal, D S D with D = |diag S|^-1/2, so that its rank test
-// compares like with like: forces per metre and moments per radian can differ by orders of
-// magnitude (a 1 nm beam: 12 EI / l^3 = 2e30 N/m beside 4 EI / l = 7e11 N m).
-class TangentSolver {
- public:
-  explicit TangentSolver(std::shared_ptr<const SparseStructure> structure)
-      : structure_(std::move(structure)) {
-    klu_l_defaults(&common_);
-  }
-  ~TangentSolver() { free_numeric(); }
-  TangentSolver(const TangentSolver&) = delete;
-  TangentSolver& operator=(const TangentSolver&) = delete;
-
-  // The tangent's values in the pattern's compressed columns (matrix() views them).
-  bool factorize(const Model& model, const Data& data, std::string* failure) {
-    use_dense_ = false;
-    null_directions = 0;
-    const JacobianPattern& p = structure_->reduced();
-    values_.assign(p.rows.size(), 0.0);
-    static_assert(kVelocityStates == kDofsPerBody, "the tangent's blocks are the pattern's");
-    constexpr int n = kVelocityStates;
-    for (size_t b = 0; b < data.stiffness.size(); ++b)
-      for (int r = 0; r < n; ++r)
-        for (int c = 0; c < n; ++c)
-          values_[p.positions[b * n * n + n * r + c]] = data.stiffness[b](r, c);
-    const Matrix s = matrix();
-    long* starts = const_cast<long*>(p.column_starts.data());  // KLU reads only
-    long* rows = const_cast<long*>(p.rows.data());
-    // The previous pivots while their growth stays within 1e3 of fresh partial pivoting (as the
-    // transient's solver does): a refactorization allocates nothing, which on a 100,000-body chain
-    // halved the time of a Newton iteration.
-    if (numeric_ &&
-        !(klu_l_refactor(starts, rows, values_.data(), structure_->symbolic(), numeric_,
-                         &common_) &&
-          common_.status == KLU_OK &&
-          klu_l_rgrowth(starts, rows, values_.data(), structure_->symbolic(), numeric_, &common_) &&
-          common_.rgrowth >= 1e-3 * fresh_growth_))
-      free_numeric();
-    if (!numeric_) {
-      numeric_ = klu_l_factor(starts, rows, values_.data(), structure_->symbolic(), &common_);
-      if (numeric_ &&
-          klu_l_rgrowth(starts, rows, values_.data(), structure_->symbolic(), numeric_, &common_))
-        fresh_growth_ = common_.rgrowth;
-    }
-    if (numeric_ && klu_l_rcond(structure_->symbolic(), numeric_, &common_)) {
-      const Eigen::VectorXd probe = Eigen::VectorXd::Ones(s.rows());
-      const Eigen::VectorXd x = solve(probe);
-      if (x.allFinite()) {
-        const Eigen::VectorXd r = s * x - probe;
-        // Pivots within 1e8 of each other and a backward-stable solve: sound. (A long chain has
-        // |S| |x| >> |b|: its residual is small relative to that, not to |b|; 1,000 segments
-        // gave backward errors ~7e-17 with pivot ratios ~8e-5.) Otherwise one solve must leave
-        // a residual small against |b|: a numerically singular matrix factorizes but solves
-        // badly (a free carriage: pivot ratio ~1e-10).
-        const double s_norm = abs_times(Eigen::VectorXd::Ones(s.cols())).maxCoeff();
-        if (floor_ < 0.0) floor_ = pivot_floor(model);
-        if (common_.rcond > floor_ &&
-            r.lpNorm<Eigen::Infinity>() <= 1e-12 * (s_norm * x.lpNorm<Eigen::Infinity>() + 1.0))
-          return true;
-        if (r.norm() <= 1e-8 * probe.norm()) return true;
-      }
-    }
-    if (s.rows() > 3000) {
-      *failure = held_by_beams(model)
-                     ? "the tangent stiffness is singular or indefinite: the structure buckles or "
-                       "snaps through under these loads"
-                     : "the tangent stiffness is singular: a body or mechanism is free to move, "
-                       "or the structure buckles under these loads";
-      return false;
-    }
-    return factorize_dense();
-  }
-  // The minimum-norm solution by a complete orthogonal decomposition.
-  bool factorize_dense() {
-    const Eigen::SparseMatrix<double> s = matrix();
-    scale_.resize(s.rows());
-    for (Eigen::Index i = 0; i < s.rows(); ++i) {
-      const double d = std::abs(s.coeff(i, i));
-      scale_(i) = d > 0.0 && std::isfinite(d) ? 1.0 / std::sqrt(d) : 1.0;
-    }
-    const Eigen::MatrixXd dense = scale_.asDiagonal() * Eigen::MatrixXd(s) * scale_.asDiagonal();
-    cod_.setThreshold(1e-12);
-    cod_.compute(dense);
-    null_directions = static_cast<int>(dense.rows() - cod_.rank());
-    use_dense_ = true;
-    return true;
-  }
-  Eigen::VectorXd apply(const Eigen::VectorXd& x) const { return matrix() * x; }
-  // S^-1 b (the minimum-norm solution, in the equilibrated variables, when S is singular).
-  Eigen::VectorXd solve(const Eigen::VectorXd& b) {
-    if (use_dense_) return scale_.cwiseProduct(cod_.solve(scale_.cwiseProduct(b)));
-    Eigen::VectorXd x = b;
-    if (!klu_l_solve(structure_->symbolic(), numeric_, x.size(), 1, x.data(), &common_))
-      x.setConstant(std::numeric_limits<double>::quiet_NaN());
-    return x;
-  }
-  // What rounding leaves in a residual evaluated at displacement x: the stiffness terms that
-  // cancel in it each carry eps of their size, eps |S| (|x| + r), where r (the element length for
-  // translations, 1 rad for rotations) stands for the rounding of the element chords and relative
-  // rotations themselves (scaled like the residual).
-  double rounding_floor(const Eigen::VectorXd& x, double length) const {
-    Eigen::VectorXd reach = x.cwiseAbs();
-    for (Eigen::Index i = 0; i < reach.size(); ++i)
-      reach(i) += (i % kDofsPerBody) < 3 ? length : 1.0;
-    return scaled_norm(kEps * abs_times(reach), length);
-  }
-  int null_directions = 0;
-
- private:
-  void free_numeric() {
-    if (numeric_) klu_l_free_numeric(&numeric_, &common_);
-  }
-
-  std::shared_ptr<const SparseStructure> structure_;
-  klu_l_common common_;
-  klu_l_numeric* numeric_ = nullptr;
-  std::vector<double> values_;
-  using Matrix = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, long>>;
-  Matrix matrix() const {
-    const JacobianPattern& p = structure_->reduced();
-    const long n = static_cast<long>(p.column_starts.size()) - 1;
-    return Matrix(n, n, p.nnz(), p.column_starts.data(), p.rows.data(), values_.data());
-  }
-  // |S| v without forming |S|.
-  Eigen::VectorXd abs_times(const Eigen::VectorXd& v) const {
-    const JacobianPattern& p = structure_->reduced();
-    Eigen::VectorXd out = Eigen::VectorXd::Zero(v.size());
-    for (Eigen::Index c = 0; c < v.size(); ++c)
-      for (long k = p.column_starts[c]; k < p.column_starts[c + 1]; ++k)
-        out(p.rows[k]) += std::abs(values_[k]) * std::abs(v(c));
-    return out;
-  }
-  Eigen::VectorXd scale_;      // D of the dense decomposition
-  double fresh_growth_ = 1.0;  // reciprocal pivot growth of the last factorization with pivoting
-  double floor_ = -1.0;        // pivot_floor of the model (computed at the first factorization)
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
-  bool use_dense_ = false;
-};
-
-struct Newton {
-  Newton(const Model& m, Data& d, double time, double len, int max_it, const Deadline& b,
-         std::shared_ptr<const SparseStructure> structure)
-      : model(m),
-        data(d),
-        t(time),
-        length(len),
-        max_iterations(max_it),
-        budget(b),
-        solver(std::move(structure)) {}
-  const Model& model;
-  Data& data;
-  double t, length;
-  int max_iterations;
-  const Deadline& budget;
-  TangentSolver solver;
-  const bool held = held_by_beams(model);  // every free body held by beams to a fixed body
-  int iterations = 0;
-  int singular = 0;
-  double residual = 0.0;
-  double floor = 0.0;       // rounding floor at the last tangent
-  double correction = 0.0;  // last correction / displacement
-  std::string failure;
-  bool final = false;      // no smaller load step can help (no equilibrium, precision, budget)
-  int no_equilibrium = 0;  // load steps in a row that found no equilibrium
-
-  struct Saved {
-    std::vector<Pose<double>> pose;
-    std::vector<Vec4> q;
-    std::vector<Vec3> rotation;
-  };
-  Saved save() const { return {data.pose, data.q, data.rotation}; }
-  void restore(const Saved& s) {
-    data.pose = s.pose;
-    data.q = s.q;
-    data.rotation = s.rotation;
-  }
-
-  double residual_at(double factor) {
-    compute_wrenches(model, data, t, factor);
-    return scaled_norm(wrench_vector(model, data), length);
-  }
-
-  bool fail(std::string why, bool no_smaller_step) {
-    failure = std::move(why);
-    final = no_smaller_step;
-    return false;
-  }
-
-  // The carriages' positions along their rails (xi_x) in the current configuration.
-  std::vector<double> carriage_positions() const {
-    std::vector<double> out;
-    for (const Rail& e : model.rails)
-      out.push_back(element_frames(e.ends, data.pose[e.ends.body1], data.pose[e.ends.body2],
-                                   rotation_measure(e))
-                        .xi(0));
-    return out;
-  }
-
-  // A carriage that a Newton iterate moved along its rail by more than kRailTravelWarning times
-  // its distance from point 1 at the start of the load step: the loads push it along the rail,
-  // where nothing holds it (a smaller load step is tried; a carriage that runs away at every load
-  // step has no equilibrium).
-  std::string runaway_carriage(const std::vector<double>& start) const {
-    const std::vector<double> now = carriage_positions();
-    for (size_t k = 0; k < model.rails.size(); ++k) {
-      const Rail& e = model.rails[k];
-      if (std::abs(now[k] - start[k]) >
-          kRailTravelWarning * std::max(std::abs(start[k]), e.min_length))
-        return "the carriage of rail \"" + e.name +
-               "\" ran away along the rail in a Newton iterate " +
-               format(
-                   "(from %.3g m to %.3g m from point 1): the loads push it along the rail, "
-                   "which does not hold it: there is no equilibrium",
-                   start[k], now[k]);
-    }
-    return "";
-  }
-
-  // Newton iterations at load factor `factor` from the current state; true when converged.
-  //
-  // Full Newton steps. With stiff axial and soft bending directions the linear predictor
-  // stretches a bent beam and |R| jumps by orders of magnitude, yet the next step (whose tangent
-  // sees the tension) removes it. Measured on the elastica (N = 4..64, P L^2/EI = 1..5): full
-  // steps converge in 6-41 iterations; backtracking on |R| took 240-8500, and a monotonicity
-  // test with the old tangent (which does not see the tension) stalled. So the line search only
-  // backtracks (halving) from steps that make the forces non-finite; divergence is caught by the
-  // iteration limit and answered by a smaller load step.
-  //
-  // Converged: the residual is below `target`, or it is at the rounding floor (eps |S| |x|) and
-  // the correction no longer moves the solution (below kCorrectionTolerance of it). A residual
-  // that stays at the floor while the corrections do not shrink is rounding-limited: the
-  // equilibrium cannot be resolved in double precision, and no load step helps.
-  bool solve(double factor, double target) {
-    double r = residual_at(factor);
-    if (!std::isfinite(r))
-      return fail(
-          "the forces are not finite (the loads or the stiffness overflow double precision)", true);
-    const std::vector<double> carriages = carriage_positions();
-    int rising = 0;
-    int noisy = 0;             // iterations in a row with the residual near its rounding floor
-    double noisy_first = 0.0;  // the correction at the first of them
-    for (int it = 0; it < max_iterations; ++it) {
-      if (r <= target) {
-        residual = r;
-        return true;
-      }
-      if (budget.passed())
-        return fail("the static analysis did not finish within its time budget", true);
-      compute_tangent(model, data, t, false, factor);
-      const Eigen::VectorXd w = wrench_vector(model, data);
-      ++iterations;
-      std::string why;
-      if (!solver.factorize(model, data, &why)) return fail(why, false);
-      singular = std::max(singular, solver.null_directions);
-      Eigen::VectorXd dx = solver.solve(-w);
-      if (!dx.allFinite()) return fail("the tangent stiffness is singular", false);
-      if (solver.null_directions > 0 && scaled_norm(solver.apply(dx) + w, length) >
-                                            std::max(1e-6 * scaled_norm(w, length), 10.0 * floor)) {
-        // Every body held by beams: no mechanism, the tangent lost its stiffness under the
-        // loads (buckling, a snap, an element at the end of its law's range); a smaller load
-        // step may pass. Otherwise a free body or mechanism is pushed: no load step helps.
-        if (held)
-          return fail(
-              "the tangent stiffness became singular along the loads (the structure "
-              "buckles or snaps through, or an element reaches the end of its law's "
-              "range)",
-              false);
-        // A smaller load step is tried (kNoEquilibriumRetries times in a row at most): an
-        // iterate far from the path may meet a direction without stiffness that the
-        // equilibrium does not have.
-        ++no_equilibrium;
-        return fail(
-            "the loads push along a direction without stiffness (a free mechanism, such as a "
-            "carriage pushed along its rails): there is no equilibrium",
-            no_equilibrium > kNoEquilibriumRetries);
-      }
-      const Eigen::VectorXd x = displacement(model, data);
-      floor = solver.rounding_floor(x, length);
-      const double size = motion_size(x, length);
-      correction = size > 0.0 ? motion_size(dx, length) / size : INFINITY;
-      // At the rounding floor a correction this small is rounding noise: the last one is applied.
-      const bool converged = r <= 10.0 * floor && correction <= kCorrectionTolerance;
-      // At most kMaxRotationStep of rotation per body in one iterate.
-      double turn = 0.0;
-      for (int k = 0; k < model.n_free(); ++k)
-        turn = std::max(turn, dx.segment<3>(kDofsPerBody * k + 3).norm());
-      if (turn > kMaxRotationStep) dx *= kMaxRotationStep / turn;
-      if (converged) {
-        apply_increment(model, data, dx);
-        residual = residual_at(factor);
-        if (std::isfinite(residual)) return true;
-        return fail("the forces are not finite", false);
-      }
-      const Saved saved = save();
-      const auto trial = [&](double fraction) {
-        restore(saved);
-        apply_increment(model, data, fraction * dx);
-        return residual_at(factor);
-      };
-      double value = trial(1.0);
-      for (double fraction = 0.5; !std::isfinite(value) && fraction > 1e-3; fraction *= 0.5)
-        value = trial(fraction);
-      if (!std::isfinite(value)) {
-        restore(saved);
-        return fail("Newton steps lead to non-finite forces", false);
-      }
-      if (std::string away = runaway_carriage(carriages); !away.empty()) return fail(away, false);
-      if (std::string turned = element_turned_beyond(model, data, kIterateRotationLimit);
-          !turned.empty())
-        return fail(turned + " in a Newton iterate", false);
-      rising = value > r ? rising + 1 : 0;
-      // Near the floor Newton converges in a few iterations (each correction a fraction of the
-      // previous one); corrections that keep their size there are moved by rounding alone.
-      if (r <= 1e3 * floor) {
-        noisy_first = noisy == 0 ? correction : noisy_first;
-        ++noisy;
-      } else {
-        noisy = 0;
-      }
-      r = value;
-      if ((noisy >= 6 && correction > 1e-2 * noisy_first) || noisy >= 12)
-        return fail("rounding errors limit this equilibrium: the residual stays at " +
-                        format("%.3g N (rounding floor %.3g N)", r, floor) +
-                        format(" while the Newton corrections still move the solution by %.2g "
-                               "of its size; the stiffness terms of this scene cancel beyond "
-                               "double precision (chains of very many short segments): use "
-                               "fewer segments",
-                               correction),
-                    true);
-      if (rising >= 8) return fail("Newton diverges (the residual grew 8 times in a row)", false);
-    }
-    residual = r;
-    if (r <= target) return true;
-    return fail("Newton did not converge in " + std::to_string(max_iterations) +
-                    (max_iterations == 1 ? " iteration" : " iterations"),
-                false);
-  }
-};
+using namespace statics;
 
 // Stability of the equilibrium in data.pose.
 struct Stability {
@@ -527,6 +118,8 @@ bool StaticOptions::IsValid(std::string* error) const {
   if (!(tolerance > 0.0 && std::isfinite(tolerance)))
     return refuse_options(error, "tolerance must be positive and finite");
   if (max_load_steps < 1) return refuse_options(error, "max_load_steps must be at least 1");
+  if (!(arc_length >= 0.0 && std::isfinite(arc_length)))
+    return refuse_options(error, "arc_length must be 0 (automatic) or positive and finite");
   if (!(max_seconds >= 0.0 && std::isfinite(max_seconds)))
     return refuse_options(error, "max_seconds must be 0 (no budget) or positive and finite");
   return true;
@@ -558,7 +151,12 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
     double done = f_ref > 0.0 && model.n_free() > 0 ? 0.0 : 1.0;
     double increment = options.load_steps > 0 ? 1.0 / options.load_steps : 1.0;
     const double min_increment = 1.0 / (1 << 20);
-    while (done < 1.0) {
+    bool path_ok = true;
+    if (done < 1.0 && options.control == StaticControl::kArcLength) {
+      path_ok = follow_path(newton, options, f_ref, result, &done);
+      if (!path_ok) result.timed_out = budget.passed();
+    }
+    while (done < 1.0 && options.control == StaticControl::kLoad) {
       if (result.load_steps >= options.max_load_steps) {
         result.message = "more than " + std::to_string(options.max_load_steps) + " load steps";
         break;
@@ -589,7 +187,7 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
         break;
       }
     }
-    result.ok = done >= 1.0;
+    result.ok = done >= 1.0 && path_ok;
     compute_wrenches(model, data, options.time, result.ok ? 1.0 : done);
     result.residual_norm = scaled_norm(wrench_vector(model, data), length);
     result.iterations = newton.iterations;

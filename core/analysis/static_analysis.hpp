@@ -36,9 +36,18 @@
 
 namespace beamrail {
 
+// How the loads are raised: by load steps (load control), or along the load-displacement path by
+// arc length (the load factor is an unknown: the path passes limit points and snaps; docs/model.md
+// "Arc-length control").
+enum class StaticControl { kLoad, kArcLength };
+
 struct StaticOptions {
   // Time at which the loads are evaluated [s]; +infinity: each load's final value.
   double time = std::numeric_limits<double>::infinity();
+  StaticControl control = StaticControl::kLoad;
+  // Arc-length control: the first step's length [m] (rotations count times the structure's
+  // characteristic length); 0: a tenth of the linear response to the full loads.
+  double arc_length = 0.0;
   int load_steps = 0;         // 0: automatic (one step, subdivided on failure); n: n equal steps
   int max_iterations = 30;    // Newton iterations per load step
   double tolerance = 1e-10;   // residual, relative to the applied load scale
@@ -50,6 +59,15 @@ struct StaticOptions {
   // Whether the options can run: true, or false with the first problem in *error. The analysis
   // refuses options that are not valid; the study reader reports them.
   bool IsValid(std::string* error) const;
+};
+
+// A converged point of an arc-length path: the load factor and the displacements of the path's
+// bodies (StaticResult::path_bodies: centre displacement and rotation vector).
+struct StaticPathPoint {
+  double load_factor = 0.0;
+  double arc_length = 0.0;  // from the start [m]
+  int iterations = 0;       // corrector iterations of this point
+  std::vector<Vec3> displacement, rotation;
 };
 
 struct StaticResult {
@@ -67,6 +85,13 @@ struct StaticResult {
   int flutter_pairs = 0;  // growing vibration pairs under non-conservative loads (> 0: not ok)
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
+  // Arc-length control: the path from the unloaded start (the last point the full loads, when
+  // reached), the bodies it records (the scene's own free bodies, not a beam's segment bodies;
+  // every free body when none is) and the first limit point's load factor (the first maximum of
+  // the load factor along the path, interpolated; NaN when none was passed).
+  std::vector<StaticPathPoint> path;
+  std::vector<int> path_bodies;
+  double limit_load_factor = std::numeric_limits<double>::quiet_NaN();
 };
 
 // At the rounding floor, a Newton correction below this fraction of the displacement has

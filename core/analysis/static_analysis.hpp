@@ -1,5 +1,6 @@
 // Static analysis (docs/model.md "Analyses"): equilibrium of all free bodies under gravity and the
-// loads at a given time, geometrically nonlinear. Newton's method on 6 unknowns per free body
+// loads at a given time, geometrically nonlinear. The loads are raised by load steps (below) or,
+// under arc-length control, along the load-displacement path (core/analysis/static_path.cpp). Newton's method on 6 unknowns per free body
 // (centre displacement and rotation increment) with the exact tangent by automatic differentiation
 // (factored by KLU with the topology's shared symbolic analysis), full Newton steps (halved only
 // when they make the forces non-finite), and automatic load stepping when a full load step fails

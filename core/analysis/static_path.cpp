@@ -95,6 +95,9 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
     result.limit_load_factor = first_limit(result.path);
     if (!ok && lambda < 1.0) *done = lambda;  // the state is the last point's
     if (!ok) result.message = message;
+    if (!ok && !std::isnan(result.limit_load_factor))
+      result.message += format("; the path passed a limit point at load factor %.6g",
+                               result.limit_load_factor);
     return ok;
   };
   const double target = options.tolerance * f_ref;

@@ -135,6 +135,11 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
                         {"negative_stiffness_directions", r.negative_directions},
                         {"flutter_pairs", r.flutter_pairs},
                         {"wall_seconds", r.wall_seconds}};
+      if (!r.path.empty()) {
+        st["control"] = "arc_length";
+        st["path_points"] = r.path.size();
+        st["limit_load_factor"] = json_number(r.limit_load_factor);  // null: none passed
+      }
       if (a.type == "static")
         j.update(st);
       else

@@ -129,6 +129,9 @@ class Runner {
     report.message = r.message;
     report.wall_seconds = r.wall_seconds;
     report.statics = r;
+    // The path, also of a run that did not reach the full loads (its limit load is the finding).
+    if (options_.result_tables && !r.path.empty())
+      keep_tables(report, {static_path_table(table_prefix(spec), case_model(spec.load_case), r)});
     if (!r.ok) return;
     add_warnings(r.warnings);
     const Model& model = case_model(spec.load_case);
@@ -375,8 +378,10 @@ class Runner {
   }
 
   static void keep_tables(AnalysisReport& report, std::vector<ResultTable> tables) {
-    for (const ResultTable& t : tables) report.tables.push_back(t.file);
-    report.result_tables = std::move(tables);
+    for (ResultTable& t : tables) {
+      report.tables.push_back(t.file);
+      report.result_tables.push_back(std::move(t));
+    }
   }
 
   // Writes the analysis's VTK files when asked for (write(&error)); false, with the analysis

@@ -34,6 +34,26 @@ std::vector<ResultTable> static_tables(const std::string& prefix, const Model& m
   return {std::move(displacements), std::move(forces)};
 }
 
+ResultTable static_path_table(const std::string& prefix, const Model& model,
+                              const StaticResult& result) {
+  ResultTable path{prefix + "static_path.csv",
+                   {"point", "load_factor", "arc_length", "iterations", "body", "dx", "dy", "dz",
+                    "rx", "ry", "rz"},
+                   {}};
+  for (size_t k = 0; k < result.path.size(); ++k) {
+    const StaticPathPoint& p = result.path[k];
+    for (size_t b = 0; b < result.path_bodies.size() && b < p.displacement.size(); ++b) {
+      std::vector<std::string> row{std::to_string(k), format_number(p.load_factor),
+                                   format_number(p.arc_length), std::to_string(p.iterations),
+                                   model.bodies[result.path_bodies[b]].name};
+      for (int c = 0; c < 3; ++c) row.push_back(format_number(p.displacement[b](c)));
+      for (int c = 0; c < 3; ++c) row.push_back(format_number(p.rotation[b](c)));
+      path.rows.push_back(std::move(row));
+    }
+  }
+  return path;
+}
+
 std::vector<ResultTable> modal_tables(const std::string& prefix, const Model& model,
                                       const ModalResult& result) {
   std::vector<std::string> header{"mode", "frequency_hz", "kind", "dominant"};

@@ -8,6 +8,7 @@
 
 #include "core/analysis/buckling_analysis.hpp"
 #include "core/analysis/modal_analysis.hpp"
+#include "core/analysis/static_analysis.hpp"
 #include "core/model/data.hpp"
 
 namespace beamrail {
@@ -28,6 +29,12 @@ struct ResultTable {
 // element_forces.csv (end forces of every beam and rail, element axes).
 std::vector<ResultTable> static_tables(const std::string& prefix, const Model& model,
                                        const Data& data);
+
+// static_path.csv of an arc-length path (StaticResult::path): per converged point and body of
+// the path (the scene's own free bodies), the load factor, arc length from the start [m],
+// corrector iterations and the body's displacement (dx, dy, dz, rotation vector rx, ry, rz).
+ResultTable static_path_table(const std::string& prefix, const Model& model,
+                              const StaticResult& result);
 
 // modes.csv (mode, frequency_hz, kind; rigid-body modes first with mode 0; the dominant direction,
 // then per direction x .. rz the participation, effective mass and its fraction of the total, see

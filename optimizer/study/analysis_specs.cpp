@@ -180,6 +180,38 @@ bool read_static(ObjectReader& r, const Model* model, AnalysisSpec& a) {
   a.statics.tolerance = r.positive("tolerance", false).value_or(a.statics.tolerance);
   if (const auto n = r.integer("max_iterations", false, 1))
     a.statics.max_iterations = static_cast<int>(std::min(*n, 10000L));
+  // How the loads are raised (docs/study_files.md "Static analysis"): load steps, or along the
+  // path by arc length (through limit points; the path in static_path.csv).
+  if (const auto control = r.choice("control", false, {"load", "arc_length"}))
+    a.statics.control =
+        *control == "arc_length" ? StaticControl::kArcLength : StaticControl::kLoad;
+  else if (r.member("control", false))
+    ok = false;
+  const bool arc = a.statics.control == StaticControl::kArcLength;
+  if (r.member("arc_length", false)) {
+    if (!arc) {
+      r.error("arc_length", "applies to \"control\": \"arc_length\"");
+      ok = false;
+    } else if (const auto ds = r.positive("arc_length", false)) {
+      a.statics.arc_length = *ds;
+    } else {
+      ok = false;
+    }
+  }
+  if (arc && r.member("load_steps", false)) {
+    r.error("load_steps",
+            "applies to \"control\": \"load\" (arc-length control chooses its own steps; "
+            "\"arc_length\" bounds their length)");
+    ok = false;
+  }
+  if (const auto n = r.integer("max_steps", false, 1)) {
+    if (*n > 1000000) {
+      r.error("max_steps", "at most 1000000 steps");
+      ok = false;
+    } else {
+      a.statics.max_load_steps = static_cast<int>(*n);
+    }
+  }
   return ok;
 }
 
@@ -246,7 +278,7 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   if (!type) {
     r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "max_frequency_hz",
              "time", "load_steps", "tolerance", "max_iterations", "modes", "about", "solver",
-             "initial"});
+             "initial", "control", "arc_length", "max_steps"});
     return std::nullopt;
   }
   bool ok = true;

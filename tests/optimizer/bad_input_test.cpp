@@ -344,6 +344,32 @@ TEST_F(BadInput, TransientBand) {
   EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
 }
 
+// A static analysis's control: "load" or "arc_length"; arc_length only with arc-length control,
+// load_steps only with load control; max_steps a count >= 1.
+TEST_F(BadInput, StaticControl) {
+  const auto static_study = [&](const Json& analysis) {
+    Json study = base();
+    study["analyses"].push_back(analysis);  // beside the base study's transient (its responses)
+    return check(study);
+  };
+  const std::string at = "bad.json:/analyses/1/";
+  EXPECT_TRUE(HasOnlyError(static_study({{"type", "static"}, {"control", "arclength"}}),
+                           at + "control:", "expected one of \"load\", \"arc_length\""));
+  EXPECT_TRUE(HasOnlyError(static_study({{"type", "static"}, {"arc_length", 0.01}}),
+                           at + "arc_length:", "applies to \"control\": \"arc_length\""));
+  EXPECT_TRUE(HasOnlyError(
+      static_study({{"type", "static"}, {"control", "arc_length"}, {"load_steps", 10}}),
+      at + "load_steps:", "applies to \"control\": \"load\""));
+  EXPECT_TRUE(HasOnlyError(
+      static_study({{"type", "static"}, {"control", "arc_length"}, {"arc_length", -1}}),
+      at + "arc_length:", "> 0"));
+  EXPECT_TRUE(HasOnlyError(static_study({{"type", "static"}, {"max_steps", 0}}),
+                           at + "max_steps:", ">= 1"));
+  const Result ok = static_study(
+      {{"type", "static"}, {"control", "arc_length"}, {"arc_length", 0.01}, {"max_steps", 50}});
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
+}
+
 // --- Loads and time functions -------------------------------------------------------------------
 
 TEST_F(BadInput, LoadOnAFixedBody) {

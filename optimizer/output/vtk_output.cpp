@@ -15,6 +15,7 @@
 
 #include "core/model/element_forces.hpp"
 #include "core/model/element_kinematics.hpp"
+#include "core/model/joint_forces.hpp"
 #include "core/model/generalized.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
@@ -244,12 +245,16 @@ class SceneDrawing {
     };
     for (const Beam& b : model.beams) ends(b.ends);
     for (const Rail& r : model.rails) ends(r.ends);
+    for (const Joint& j : model.joints) {
+      extend(centre(model, initial, j.body1) + initial.pose[j.body1].A * j.r1);
+      extend(centre(model, initial, j.body2) + initial.pose[j.body2].A * j.r2);
+    }
     size_ = (hi - lo).allFinite() ? (hi - lo).norm() : 0.0;
     if (!(size_ > 0.0)) size_ = characteristic_length(model);
 
     std::vector<std::string> body_names, element_names;
     std::vector<int32_t> body_index, glyph_body, element_index;
-    std::vector<uint8_t> generated, fixed, glyph_kind, element_kind;
+    std::vector<uint8_t> generated, fixed, glyph_kind, element_kind, joint_kind;
     for (size_t i = 1; i < model.bodies.size(); ++i) {
       const Body& b = model.bodies[i];
       Drawn d;
@@ -262,6 +267,10 @@ class SceneDrawing {
         };
         for (const Beam& e : model.beams) attach(e.ends);
         for (const Rail& e : model.rails) attach(e.ends);
+        for (const Joint& j : model.joints) {
+          if (j.body1 == d.body) d.levers.push_back(j.r1);
+          if (j.body2 == d.body) d.levers.push_back(j.r2);
+        }
         for (const Load& l : model.loads)
           if (l.kind == LoadKind::kForce && l.body == d.body) d.levers.push_back(l.offset);
       }
@@ -301,6 +310,7 @@ class SceneDrawing {
       for (int k = 0; k < n; ++k) c.s.push_back(static_cast<double>(k) / (n - 1));
       element_index.push_back(index);
       element_kind.push_back(rail);
+      joint_kind.push_back(0);
       curves_.push_back(c);
     };
     for (size_t i = 0; i < model.beams.size(); ++i) {
@@ -315,6 +325,18 @@ class SceneDrawing {
       curves_.back().measure = rotation_measure(r);
       curves_.back().lower = r.travel_min, curves_.back().upper = r.travel_max;
       element_names.push_back(r.name);
+    }
+    // A joint: a line from its point on body 1 to its point on body 2 (as long as its gap).
+    for (size_t i = 0; i < model.joints.size(); ++i) {
+      Curve c;
+      c.joint = true;
+      c.index = static_cast<int>(i);
+      c.s = {0.0, 1.0};
+      element_index.push_back(c.index);
+      element_kind.push_back(0);
+      joint_kind.push_back(1);
+      element_names.push_back(model.joints[i].name);
+      curves_.push_back(c);
     }
     for (Curve& c : curves_) {
       c.first = n_curve_points_;
@@ -333,6 +355,7 @@ class SceneDrawing {
     element_index_ = number_bytes(element_index);
     element_names_ = string_bytes(element_names);
     element_kind_ = number_bytes(element_kind);
+    joint_kind_ = number_bytes(joint_kind);
     place(initial, initial_);
   }
 
@@ -408,12 +431,22 @@ class SceneDrawing {
     apply_increment(model_, work, dx);
   }
 
-  // End forces of every element (beams, then rails) in the state of `data`.
-  void forces(const Data& data, std::vector<EndForces>& out, std::vector<double>& stress) const {
+  // End forces of every element (beams, then rails, then joints) in the state of `data`; the
+  // joints' gaps |p2 - p1| (NaN for beams and rails).
+  void forces(const Data& data, std::vector<EndForces>& out, std::vector<double>& stress,
+              std::vector<double>& gaps) const {
     out.resize(curves_.size());
     stress.resize(curves_.size());
+    gaps.assign(curves_.size(), kNaN);
     for (size_t k = 0; k < curves_.size(); ++k) {
       const Curve& c = curves_[k];
+      if (c.joint) {
+        const Joint& j = model_.joints[c.index];
+        out[k] = joint_end_forces(model_, data, c.index);
+        stress[k] = kNaN;
+        gaps[k] = joint_gap(j, data.pose[j.body1], data.pose[j.body2]).norm();
+        continue;
+      }
       out[k] =
           c.rail ? rail_end_forces(model_, data, c.index) : beam_end_forces(model_, data, c.index);
       stress[k] = end_stress(c.rail ? model_.rails[c.index].section : model_.beams[c.index].section,
@@ -428,7 +461,7 @@ class SceneDrawing {
   // Constant parts of the files.
   Cells centre_verts_, glyph_lines_, glyph_polys_, curve_lines_;
   std::string body_index_, body_names_, generated_, fixed_, glyph_body_, glyph_kind_,
-      element_index_, element_names_, element_kind_;
+      element_index_, element_names_, element_kind_, joint_kind_;
 
  private:
   struct Drawn {
@@ -438,6 +471,7 @@ class SceneDrawing {
   };
   struct Curve {
     bool rail = false;
+    bool joint = false;  // index is a joint's; ends is null
     RotationMeasure measure = RotationMeasure::kAngles;  // the element's (slopes from phi)
     int index = 0;
     const ElementEnds* ends = nullptr;
@@ -476,6 +510,12 @@ class SceneDrawing {
   // to point 2 (a rail: to the carriage, then straight on along its end slope to the travel's end
   // beyond it, and straight along the rail's axis behind point 1).
   void draw(const Curve& c, const Data& data, Vec3* out) const {
+    if (c.joint) {
+      const Joint& j = model_.joints[c.index];
+      out[0] = centre(model_, data, j.body1) + data.pose[j.body1].A * j.r1;
+      out[1] = centre(model_, data, j.body2) + data.pose[j.body2].A * j.r2;
+      return;
+    }
     const ElementEnds& e = *c.ends;
     const Pose<double>& b1 = data.pose[e.body1];
     const ElementFrames<double> f = element_frames(e, b1, data.pose[e.body2], c.measure);
@@ -523,6 +563,7 @@ struct FrameData {
   const SceneDrawing::Geometry* shape = nullptr;
   const std::vector<EndForces>* forces = nullptr;
   const std::vector<double>* stress = nullptr;
+  const std::vector<double>* gaps = nullptr;
   std::vector<std::pair<std::string, double>> fields;
 };
 
@@ -600,7 +641,8 @@ bool write_frame(const SceneDrawing& d, const SceneDrawing::Geometry& g, const F
     v.cell_data("element_index", &d.element_index_, 1, "Int32");
     v.cell_data("element", &d.element_names_, 1, "String");
     v.cell_data("rail", &d.element_kind_, 1, "UInt8");
-    std::string f1, m1, f2, m2, axial, stress;
+    v.cell_data("joint", &d.joint_kind_, 1, "UInt8");
+    std::string f1, m1, f2, m2, axial, stress, gap;
     if (data.forces) {
       for (size_t k = 0; k < data.forces->size(); ++k) {
         const EndForces& e = (*data.forces)[k];
@@ -608,8 +650,11 @@ bool write_frame(const SceneDrawing& d, const SceneDrawing::Geometry& g, const F
           put(f1, e.end1(c)), put(m1, e.end1(3 + c));
           put(f2, e.end2(c)), put(m2, e.end2(3 + c));
         }
-        put(axial, e.end2(0));
+        // A joint's gap in place of an axial force (its fx is along an axis, not a tension).
+        const double joint_gap = (*data.gaps)[k];
+        put(axial, std::isnan(joint_gap) ? e.end2(0) : kNaN);
         put(stress, (*data.stress)[k]);
+        put(gap, joint_gap);
       }
       v.cell_data("force_end1", &f1, 3);
       v.cell_data("moment_end1", &m1, 3);
@@ -617,6 +662,7 @@ bool write_frame(const SceneDrawing& d, const SceneDrawing::Geometry& g, const F
       v.cell_data("moment_end2", &m2, 3);
       v.cell_data("axial_force", &axial);
       v.cell_data("stress", &stress);
+      v.cell_data("gap", &gap);
     }
     v.lines(&d.curve_lines_);
     if (!v.write(folder / (std::string(stem) + ".elements.vtp"), written, error)) return false;
@@ -651,7 +697,7 @@ struct VtkOutput::Series {
   std::unique_ptr<SceneDrawing> drawing;
   SceneDrawing::Geometry geometry;
   std::vector<EndForces> forces;
-  std::vector<double> stress;
+  std::vector<double> stress, gaps;
   std::vector<std::pair<double, long>> frames;
 };
 
@@ -697,16 +743,17 @@ bool VtkOutput::write_static_frames(const std::string& analysis, const Model& mo
   const SceneDrawing d(model);
   const Data initial(model);
   std::vector<EndForces> forces;
-  std::vector<double> stress;
+  std::vector<double> stress, gaps;
   SceneDrawing::Geometry g;
   const fs::path folder = directory_ / analysis;
   for (int k = 0; k < 2; ++k) {
     const Data& state = k == 0 ? initial : deformed;
     d.place(state, g);
-    d.forces(state, forces, stress);
+    d.forces(state, forces, stress, gaps);
     FrameData fd;
     fd.forces = &forces;
     fd.stress = &stress;
+    fd.gaps = &gaps;
     fd.fields = {{"TimeValue", k}};
     if (!write_frame(d, g, fd, folder, k, &bytes_, error)) return false;
   }
@@ -825,10 +872,11 @@ void VtkOutput::frame(double t, const Data& data) {
   const Timer timer(&s.seconds);
   const SceneDrawing& d = *s.drawing;
   d.place(data, s.geometry);
-  d.forces(data, s.forces, s.stress);
+  d.forces(data, s.forces, s.stress, s.gaps);
   FrameData fd;
   fd.forces = &s.forces;
   fd.stress = &s.stress;
+  fd.gaps = &s.gaps;
   fd.fields = {{"TimeValue", t}};
   const long k = static_cast<long>(s.frames.size());
   std::string error;

@@ -15,10 +15,11 @@
 
 #include "core/model/element_forces.hpp"
 #include "core/model/element_kinematics.hpp"
-#include "core/model/joint_forces.hpp"
 #include "core/model/generalized.hpp"
+#include "core/model/joint_forces.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
+#include "optimizer/output/vtp_file.hpp"
 
 namespace beamrail {
 
@@ -26,8 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-static_assert(std::endian::native == std::endian::little,
-              "the VTK files are written little-endian, as the host's doubles are");
+using namespace vtp;  // NOLINT: the file writer of this file alone
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Points along a curve: a whole beam or rail, and one segment of a split beam (its neighbours
@@ -51,181 +51,6 @@ class Timer {
   double* seconds_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
-
-template <class T>
-void put(std::string& bytes, T value) {
-  bytes.append(reinterpret_cast<const char*>(&value), sizeof(T));
-}
-
-void put(std::string& bytes, const Vec3& v) {
-  for (int c = 0; c < 3; ++c) put(bytes, v(c));
-}
-
-std::string vec3_bytes(const std::vector<Vec3>& points) {
-  std::string bytes;
-  bytes.reserve(points.size() * 3 * sizeof(double));
-  for (const Vec3& p : points) put(bytes, p);
-  return bytes;
-}
-
-// One DataArray of a .vtp file, its bytes in the appended section (raw, each block preceded by
-// its length as UInt64).
-struct Array {
-  std::string name;
-  const char* type = "Float64";  // Float64, Int64, Int32, UInt8 or String
-  int components = 1;
-  const std::string* bytes = nullptr;  // borrowed: lives until the file is written
-};
-
-// Cells of one kind (Verts, Lines, Polys): connectivity and end offsets, Int32 (a frame holds
-// far fewer than 2^31 points).
-struct Cells {
-  std::string connectivity, offsets;
-  long count = 0;
-  void add(const std::vector<int64_t>& points) {
-    for (int64_t p : points) put(connectivity, static_cast<int32_t>(p));
-    put(offsets, static_cast<int32_t>(connectivity.size() / sizeof(int32_t)));
-    ++count;
-  }
-};
-
-// One .vtp file: PolyData with field data, point data, cell data, points and cells.
-class Vtp {
- public:
-  void field(const std::string& name, double value) {
-    owned_.emplace_back();
-    put(owned_.back(), value);
-    field_.push_back({name, "Float64", 1, &owned_.back()});
-  }
-  void point_data(const std::string& name, const std::string* bytes, int components = 3,
-                  const char* type = "Float64") {
-    point_.push_back({name, type, components, bytes});
-  }
-  void cell_data(const std::string& name, const std::string* bytes, int components = 1,
-                 const char* type = "Float64") {
-    cell_.push_back({name, type, components, bytes});
-  }
-  void points(const std::string* bytes, long n) {
-    points_ = {"Points", "Float64", 3, bytes}, n_ = n;
-  }
-  void verts(const Cells* c) { verts_ = c; }
-  void lines(const Cells* c) { lines_ = c; }
-  void polys(const Cells* c) { polys_ = c; }
-
-  // Writes the file; false with *error naming it and the system's reason.
-  bool write(const fs::path& path, long long* written, std::string* error) const {
-    std::string xml =
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
-        "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n";
-    std::vector<const std::string*> blocks;
-    uint64_t offset = 0;
-    const auto array = [&](const Array& a, bool named) {
-      // VTK reads string arrays (null-terminated strings) from <Array>, numbers from <DataArray>.
-      xml += std::string(a.type) == "String" ? "<Array type=\"" : "<DataArray type=\"";
-      xml += a.type;
-      xml += "\"";
-      if (named) xml += " Name=\"" + a.name + "\"";
-      if (a.components != 1) xml += " NumberOfComponents=\"" + std::to_string(a.components) + "\"";
-      xml += " format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
-      blocks.push_back(a.bytes);
-      offset += sizeof(uint64_t) + a.bytes->size();
-    };
-    const auto section = [&](const char* tag, const std::vector<Array>& arrays) {
-      if (arrays.empty()) return;
-      xml += "<";
-      xml += tag;
-      xml += ">\n";
-      for (const Array& a : arrays) array(a, true);
-      xml += "</";
-      xml += tag;
-      xml += ">\n";
-    };
-    if (!field_.empty()) {
-      xml += "<FieldData>\n";
-      for (const Array& a : field_) {
-        xml += "<DataArray type=\"Float64\" Name=\"" + a.name +
-               "\" NumberOfTuples=\"1\" format=\"appended\" offset=\"" + std::to_string(offset) +
-               "\"/>\n";
-        blocks.push_back(a.bytes);
-        offset += sizeof(uint64_t) + a.bytes->size();
-      }
-      xml += "</FieldData>\n";
-    }
-    const auto count = [](const Cells* c) { return std::to_string(c ? c->count : 0); };
-    xml += "<Piece NumberOfPoints=\"" + std::to_string(n_) + "\" NumberOfVerts=\"" + count(verts_) +
-           "\" NumberOfLines=\"" + count(lines_) + "\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
-           count(polys_) + "\">\n";
-    section("PointData", point_);
-    section("CellData", cell_);
-    xml += "<Points>\n";
-    array(points_, false);
-    xml += "</Points>\n";
-    const auto cells = [&](const char* tag, const Cells* c) {
-      if (!c || c->count == 0) return;
-      xml += "<";
-      xml += tag;
-      xml += ">\n";
-      array({"connectivity", "Int32", 1, &c->connectivity}, true);
-      array({"offsets", "Int32", 1, &c->offsets}, true);
-      xml += "</";
-      xml += tag;
-      xml += ">\n";
-    };
-    cells("Verts", verts_);
-    cells("Lines", lines_);
-    cells("Polys", polys_);
-    xml += "</Piece>\n</PolyData>\n<AppendedData encoding=\"raw\">\n_";
-
-    std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) {
-      *error = write_error(path, errno);
-      return false;
-    }
-    bool ok = std::fwrite(xml.data(), 1, xml.size(), f) == xml.size();
-    long long total = static_cast<long long>(xml.size());
-    for (const std::string* b : blocks) {
-      if (!ok) break;
-      const uint64_t n = b->size();
-      ok = std::fwrite(&n, sizeof n, 1, f) == 1 && std::fwrite(b->data(), 1, n, f) == n;
-      total += static_cast<long long>(sizeof n + n);
-    }
-    static const std::string tail = "\n</AppendedData>\n</VTKFile>\n";
-    ok = ok && std::fwrite(tail.data(), 1, tail.size(), f) == tail.size();
-    total += static_cast<long long>(tail.size());
-    const int e = errno;
-    const bool closed = std::fclose(f) == 0;
-    if (!ok || !closed) {
-      *error = write_error(path, ok ? errno : e);
-      return false;
-    }
-    *written += total;
-    return true;
-  }
-
- private:
-  std::vector<Array> field_, point_, cell_;
-  std::list<std::string> owned_;
-  Array points_;
-  long n_ = 0;
-  const Cells *verts_ = nullptr, *lines_ = nullptr, *polys_ = nullptr;
-};
-
-// Null-terminated strings, the bytes of a VTK String array.
-std::string string_bytes(const std::vector<std::string>& strings) {
-  std::string bytes;
-  for (const std::string& s : strings) {
-    bytes += s;
-    bytes += '\0';
-  }
-  return bytes;
-}
-
-template <class T>
-std::string number_bytes(const std::vector<T>& values) {
-  std::string bytes;
-  for (T v : values) put(bytes, v);
-  return bytes;
-}
 
 }  // namespace
 
@@ -471,7 +296,7 @@ class SceneDrawing {
   };
   struct Curve {
     bool rail = false;
-    bool joint = false;  // index is a joint's; ends is null
+    bool joint = false;                                  // index is a joint's; ends is null
     RotationMeasure measure = RotationMeasure::kAngles;  // the element's (slopes from phi)
     int index = 0;
     const ElementEnds* ends = nullptr;

@@ -35,11 +35,12 @@
 // design drawn).
 //
 // Written by hand, not with the VTK library. What the files hold is three small PolyData sets a
-// frame, which VTK's documented XML format (raw binary appended data) takes in ~150 lines here;
-// the library's headers (Debian libvtk9-dev) would add 149 packages and 335 MB to every machine
-// that builds beamrail, even one that already has VTK's runtime (GDAL, HDF5, NetCDF, FFmpeg, the
-// Java bindings come with it), for the same bytes. The tests read every file back with VTK's own
-// reader (python3-vtk9, installed by the test set-up only) and compare it with the tables.
+// frame, which VTK's documented XML format (raw binary appended data) takes in ~200 lines
+// (optimizer/output/vtp_file.hpp, .cpp); the library's headers (Debian libvtk9-dev) would add
+// 149 packages and 335 MB to every machine that builds beamrail, even one that already has VTK's
+// runtime (GDAL, HDF5, NetCDF, FFmpeg, the Java bindings come with it), for the same bytes. The
+// tests read every file back with VTK's own reader (python3-vtk9, installed by the test set-up
+// only) and compare it with the tables.
 #pragma once
 
 #include <filesystem>

@@ -40,9 +40,8 @@ std::vector<ResultTable> static_tables(const std::string& prefix, const Model& m
   for (const Joint& j : model.joints) {
     const Pose<double>&b1 = data.pose[j.body1], &b2 = data.pose[j.body2];
     const Vec3 g = joint_gap(j, b1, b2);
-    gaps.rows.push_back({j.name, format_number(g.norm()), format_number(g(0)),
-                         format_number(g(1)), format_number(g(2)),
-                         format_number(joint_angle(j, b1, b2))});
+    gaps.rows.push_back({j.name, format_number(g.norm()), format_number(g(0)), format_number(g(1)),
+                         format_number(g(2)), format_number(joint_angle(j, b1, b2))});
   }
   out.push_back(std::move(gaps));
   return out;

@@ -9,7 +9,7 @@ namespace beamrail {
 
 const std::vector<std::string> kResponseQuantities = {
     "frequency",  "displacement",  "rotation",        "peak_displacement", "mass",
-    "max_stress", "element_force", "buckling_factor", "expression", "joint_gap"};
+    "max_stress", "element_force", "buckling_factor", "expression",        "joint_gap"};
 
 namespace {
 

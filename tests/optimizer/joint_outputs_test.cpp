@@ -1,6 +1,6 @@
 // Joints in the outputs of a static analysis (docs/study_files.md): element_forces.csv rows in the
-// joint frame, joint_gaps.csv, and the responses element_force (of a joint) and joint_gap; read back
-// from the tables and the responses and compared with the statics of a weight on a joint:
+// joint frame, joint_gaps.csv, and the responses element_force (of a joint) and joint_gap; read
+// back from the tables and the responses and compared with the statics of a weight on a joint:
 //  - a weight W = m g hanging from a spherical joint: the joint force is W, its gap W / k_f;
 //  - a weight on a bracket: a body whose centre lies d beside a fixed joint: the joint carries W
 //    and the moment W d, and gives way by the gap W / k_f and the angle W d / k_m.
@@ -24,27 +24,28 @@ constexpr double kMass = 3.0, kG = 9.81, kD = 0.5, kCompliance = 1e-6;
 // A body of kMass whose centre lies at `centre` from a joint of `type` at the origin to ground,
 // under gravity -y; responses of the joint's end forces and gap.
 Json study(const std::string& type, const Json& centre) {
-  return {{"name", "joint_outputs"},
-          {"scene",
-           {{"gravity", {0, -kG, 0}},
-            {"bodies",
-             {{{"name", "weight"},
-               {"mass", kMass},
-               {"inertia", {0.01, 0.02, 0.03}},
-               {"position", centre}}}},
-            {"joints",
-             {{{"name", "j"},
-               {"type", type},
-               {"body1", "ground"},
-               {"body2", "weight"},
-               {"point", {0, 0, 0}},
-               {"relative_compliance", kCompliance}}}}}},
-          {"analyses", {{{"type", "static"}}}},
-          {"responses",
-           {{"fy2", {{"quantity", "element_force"}, {"element", "j"}, {"end", 2}, {"component", "fy"}}},
-            {"fy1", {{"quantity", "element_force"}, {"element", "j"}, {"component", "fy"}}},
-            {"mz2", {{"quantity", "element_force"}, {"element", "j"}, {"end", 2}, {"component", "mz"}}},
-            {"gap", {{"quantity", "joint_gap"}, {"joint", "j"}}}}}};
+  return {
+      {"name", "joint_outputs"},
+      {"scene",
+       {{"gravity", {0, -kG, 0}},
+        {"bodies",
+         {{{"name", "weight"},
+           {"mass", kMass},
+           {"inertia", {0.01, 0.02, 0.03}},
+           {"position", centre}}}},
+        {"joints",
+         {{{"name", "j"},
+           {"type", type},
+           {"body1", "ground"},
+           {"body2", "weight"},
+           {"point", {0, 0, 0}},
+           {"relative_compliance", kCompliance}}}}}},
+      {"analyses", {{{"type", "static"}}}},
+      {"responses",
+       {{"fy2", {{"quantity", "element_force"}, {"element", "j"}, {"end", 2}, {"component", "fy"}}},
+        {"fy1", {{"quantity", "element_force"}, {"element", "j"}, {"component", "fy"}}},
+        {"mz2", {{"quantity", "element_force"}, {"element", "j"}, {"end", 2}, {"component", "mz"}}},
+        {"gap", {{"quantity", "joint_gap"}, {"joint", "j"}}}}}};
 }
 
 struct Outcome {
@@ -92,20 +93,23 @@ TEST(JointOutputs, AWeightHangingFromASphericalJointPullsItWithItsWeight) {
   const double w = kMass * kG;
   ASSERT_EQ(o.forces.count("j.1") + o.forces.count("j.2"), 2u);
   ASSERT_FALSE(o.gaps.empty());
-  std::printf("spherical joint under a %.4f N weight: fy at end 2 %.10f N (table %s), end 1 %.10f "
-              "N; gap %.6e m (c d = %.6e), angle %s\n",
-              w, o.responses.at("fy2"), o.forces.at("j.2").at("fy").c_str(), o.responses.at("fy1"),
-              o.responses.at("gap"), kCompliance * kD, o.gaps.at("angle").c_str());
+  std::printf(
+      "spherical joint under a %.4f N weight: fy at end 2 %.10f N (table %s), end 1 %.10f "
+      "N; gap %.6e m (c d = %.6e), angle %s\n",
+      w, o.responses.at("fy2"), o.forces.at("j.2").at("fy").c_str(), o.responses.at("fy1"),
+      o.responses.at("gap"), kCompliance * kD, o.gaps.at("angle").c_str());
   // On the joint: pulled down by the weight at end 2 (minus the force it holds the weight up
   // with), held up at end 1. The joint's force is linear in its gap: exact but for rounding.
   EXPECT_NEAR(o.responses.at("fy2"), -w, 1e-9 * w);
   EXPECT_NEAR(o.responses.at("fy1"), w, 1e-9 * w);
   EXPECT_EQ(number(o.forces.at("j.2"), "fy"), o.responses.at("fy2"));
   for (const char* c : {"fx", "fz", "mx", "my", "mz"})
-    for (const char* end : {"j.1", "j.2"}) EXPECT_LT(std::abs(number(o.forces.at(end), c)), 1e-9 * w);
+    for (const char* end : {"j.1", "j.2"})
+      EXPECT_LT(std::abs(number(o.forces.at(end), c)), 1e-9 * w);
   EXPECT_NEAR(o.responses.at("gap") / (kCompliance * kD), 1.0, 1e-6);
   EXPECT_NEAR(number(o.gaps, "gap"), o.responses.at("gap"), 1e-15);
-  EXPECT_NEAR(number(o.gaps, "gy"), -kCompliance * kD, 1e-6 * kCompliance * kD);  // it stretched down
+  EXPECT_NEAR(number(o.gaps, "gy"), -kCompliance * kD,
+              1e-6 * kCompliance * kD);  // it stretched down
   EXPECT_EQ(number(o.gaps, "angle"), 0.0);
 }
 
@@ -113,10 +117,11 @@ TEST(JointOutputs, AWeightOnABracketHeldByAFixedJointLoadsItWithWAndWd) {
   const Outcome o = run(study("fixed", {kD, 0, 0}));
   const double w = kMass * kG;
   ASSERT_FALSE(o.gaps.empty());
-  std::printf("fixed joint, weight %.4f N at %.2f m: fy2 %.10f N, mz2 %.10f N m (W d = %.10f), "
-              "gap %.6e m (c d = %.1e), angle %.6e rad (c = %.0e)\n",
-              w, kD, o.responses.at("fy2"), o.responses.at("mz2"), w * kD, o.responses.at("gap"),
-              kCompliance * kD, number(o.gaps, "angle"), kCompliance);
+  std::printf(
+      "fixed joint, weight %.4f N at %.2f m: fy2 %.10f N, mz2 %.10f N m (W d = %.10f), "
+      "gap %.6e m (c d = %.1e), angle %.6e rad (c = %.0e)\n",
+      w, kD, o.responses.at("fy2"), o.responses.at("mz2"), w * kD, o.responses.at("gap"),
+      kCompliance * kD, number(o.gaps, "angle"), kCompliance);
   EXPECT_NEAR(o.responses.at("fy2"), -w, 1e-9 * w);
   // The bracket turns by c: the weight's lever shortens by d c^2 / 2, far below these bounds.
   EXPECT_NEAR(o.responses.at("mz2"), -w * kD, 1e-9 * w * kD);

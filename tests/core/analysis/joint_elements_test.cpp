@@ -156,7 +156,8 @@ TEST(JointElements, ATipMassOnABeamClampedByAFixedJointVibratesAsClamped) {
   options.modes = 2;
   const ModalResult r = solve_modal(model, options, data);
   ASSERT_TRUE(r.ok) << r.message;
-  const double exact = two_by_two(12 * kEI / (l * l * l), -6 * kEI / (l * l), 4 * kEI / l, mass, j).first;
+  const double exact =
+      two_by_two(12 * kEI / (l * l * l), -6 * kEI / (l * l), 4 * kEI / l, mass, j).first;
   EXPECT_EQ(r.shift, 0.0);
   EXPECT_EQ(r.rigid_modes, 0);
   EXPECT_FALSE(has_warning(r.warnings, "deform joints"));
@@ -164,8 +165,9 @@ TEST(JointElements, ATipMassOnABeamClampedByAFixedJointVibratesAsClamped) {
     const Mode* mode = elastic_mode(r, k);
     ASSERT_NE(mode, nullptr);
     const double error = (mode->eigenvalue - exact) / exact;
-    std::printf("tip mass on a beam clamped by a fixed joint, mode %d: w^2 = %.10e (exact %.10e, %+.2e)\n",
-                k, mode->eigenvalue, exact, error);
+    std::printf(
+        "tip mass on a beam clamped by a fixed joint, mode %d: w^2 = %.10e (exact %.10e, %+.2e)\n",
+        k, mode->eigenvalue, exact, error);
     EXPECT_LT(std::abs(error), 1e-5);  // the clamp gives way by ~1e-6 of the beam
   }
 }
@@ -248,8 +250,7 @@ TEST(JointElements, AHangingRodOnARevoluteJointSwingsAsAMechanismAboveItsPenalty
   EXPECT_NEAR(swing.eigenvalue / swing_exact, 1.0, 1e-5);
   const double kf = model.joints[0].k_force, km = model.joints[0].k_moment;
   const auto [out_low, out_high] = two_by_two(kf, -kf * kD, kf * kD * kD + km, kM, kIc);
-  std::vector<double> exact = {kf / kM, km / kIc, kf * (1 / kM + kD * kD / kIc), out_low,
-                               out_high};
+  std::vector<double> exact = {kf / kM, km / kIc, kf * (1 / kM + kD * kD / kIc), out_low, out_high};
   std::sort(exact.begin(), exact.end());
   const std::vector<double> elastic = elastic_eigenvalues(r);
   ASSERT_EQ(elastic.size(), 5u);

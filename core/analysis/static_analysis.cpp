@@ -204,6 +204,12 @@ class TangentSolver {
       reach(i) += (i % kDofsPerBody) < 3 ? length : 1.0;
     return scaled_norm(kEps * abs_times(reach), length);
   }
+  // What rounding leaves in the residual of a solve S dx = b: eps |S| |dx| (scaled like the
+  // residual). The minimum-norm solve of a tangent whose soft directions are many decades below
+  // its stiff ones (the penalty of a joint) leaves that much, however exact the equilibrium.
+  double solve_rounding(const Eigen::VectorXd& dx, double length) const {
+    return scaled_norm(kEps * abs_times(dx.cwiseAbs()), length);
+  }
   int null_directions = 0;
 
  private:
@@ -354,8 +360,13 @@ struct Newton {
       singular = std::max(singular, solver.null_directions);
       Eigen::VectorXd dx = solver.solve(-w);
       if (!dx.allFinite()) return fail("the tangent stiffness is singular", false);
-      if (solver.null_directions > 0 && scaled_norm(solver.apply(dx) + w, length) >
-                                            std::max(1e-6 * scaled_norm(w, length), 10.0 * floor)) {
+      // A minimum-norm solve that leaves more of the forces than 1e-6 of them, the rounding
+      // floor and the solve's own rounding (a bob on a revolute joint at a cantilever's tip, c =
+      // 1e-6: 6e-6 of the forces, a third of eps |S| |dx|) pushes along its null directions.
+      if (solver.null_directions > 0 &&
+          scaled_norm(solver.apply(dx) + w, length) >
+              std::max({1e-6 * scaled_norm(w, length), 10.0 * floor,
+                        10.0 * solver.solve_rounding(dx, length)})) {
         // Every body held by beams: no mechanism, the tangent lost its stiffness under the
         // loads (buckling, a snap, an element at the end of its law's range); a smaller load
         // step may pass. Otherwise a free body or mechanism is pushed: no load step helps.

@@ -363,10 +363,9 @@ struct Newton {
       // A minimum-norm solve that leaves more of the forces than 1e-6 of them, the rounding
       // floor and the solve's own rounding (a bob on a revolute joint at a cantilever's tip, c =
       // 1e-6: 6e-6 of the forces, a third of eps |S| |dx|) pushes along its null directions.
-      if (solver.null_directions > 0 &&
-          scaled_norm(solver.apply(dx) + w, length) >
-              std::max({1e-6 * scaled_norm(w, length), 10.0 * floor,
-                        10.0 * solver.solve_rounding(dx, length)})) {
+      if (solver.null_directions > 0 && scaled_norm(solver.apply(dx) + w, length) >
+                                            std::max({1e-6 * scaled_norm(w, length), 10.0 * floor,
+                                                      10.0 * solver.solve_rounding(dx, length)})) {
         // Every body held by beams: no mechanism, the tangent lost its stiffness under the
         // loads (buckling, a snap, an element at the end of its law's range); a smaller load
         // step may pass. Otherwise a free body or mechanism is pushed: no load step helps.

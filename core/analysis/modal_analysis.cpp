@@ -437,6 +437,12 @@ bool refuse_options(std::string* error, const std::string& message) {
   return false;
 }
 
+std::string hz_text(double hz) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.4g Hz", hz);
+  return text;
+}
+
 }  // namespace
 
 bool ModalOptions::IsValid(std::string* error) const {
@@ -537,6 +543,24 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     }
     result.ok = true;
     participations(model, data, m, result);
+    // Elastic modes that deform joints and no beam or rail: the joints' penalty stiffness, not the
+    // structure, sets their frequencies (they rise as relative_compliance falls).
+    if (!model.joints.empty()) {
+      int penalty_modes = 0, elastic_number = 0, first_penalty = 0;
+      double first_hz = 0.0;
+      for (const Mode& mode : result.modes) {
+        if (mode.kind == Mode::Kind::kRigid) continue;
+        ++elastic_number;
+        if (deformation.element_ratio(mode.shape) > kRigidModeDeformation) continue;
+        if (penalty_modes++ == 0) first_penalty = elastic_number, first_hz = mode.frequency_hz;
+      }
+      if (penalty_modes > 0)
+        result.warnings.push_back(
+            std::to_string(penalty_modes) + " elastic mode(s) deform joints and no beam or rail " +
+            "(the first: mode " + std::to_string(first_penalty) + ", " + hz_text(first_hz) + ")" +
+            ": the joints' penalty stiffness sets their frequencies (they rise as the joints' "
+            "relative_compliance falls), not the structure");
+    }
     if (options.keep_mass) result.mass = m;
     // Resolution of each non-rigid mode against the rounding of the stiffness terms.
     const auto abs_times = [&sym](const Eigen::VectorXd& x) {

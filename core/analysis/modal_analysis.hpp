@@ -18,6 +18,10 @@
 //
 // A mode is rigid when it deforms no element (core/analysis/element_deformation.hpp), never by the
 // size of its eigenvalue: a soft elastic mode may have an eigenvalue 1e-20 of the stiffest one.
+// Joints are elements: a mode that strains a joint's penalty is elastic (the run warns when one
+// deforms joints and no beam or rail: its frequency is the penalty's), while a mechanism's motion
+// that a joint allows (a pendulum swinging about its revolute joint) is rigid, its w^2 the load
+// stiffness's.
 #pragma once
 
 #include <Eigen/Core>

@@ -79,7 +79,11 @@ inline Eigen::VectorXd displacement(const Model& model, const Data& data) {
 // that of one segment: a 512-chord bend has 2e-9), so a structure whose every body is held by
 // beams (no mechanism is possible) accepts pivots down to 1e-8 / n^3, with n its total element
 // length over its shortest element, but not below 1e-14, where rounding begins; a structure that
-// is not held may be a mechanism (a free carriage: 1e-10), and keeps 1e-8.
+// is not held may be a mechanism (a free carriage: 1e-10), and keeps 1e-8. Joints are stiffer than
+// the stiffest element by 1 / c (c their relative compliance, docs/model.md "Joints"), which
+// spreads the pivots of a held structure by as much: its floor is c times lower (a 600-segment
+// cantilever clamped and welded by fixed joints at c = 1e-6: rcond 3e-15, its solves backward
+// stable and its deflection P L^3 / 3 EI to 4e-8, tests/core/analysis/joint_elements_test.cpp).
 inline double pivot_floor(const Model& model) {
   if (!held_by_beams(model)) return 1e-8;
   double total = 0.0, shortest = INFINITY;
@@ -87,8 +91,10 @@ inline double pivot_floor(const Model& model) {
     total += e.ends.length;
     shortest = std::min(shortest, e.ends.length);
   }
+  double compliance = 1.0;
+  for (const Joint& j : model.joints) compliance = std::min(compliance, j.relative_compliance);
   const double n = shortest > 0.0 && std::isfinite(total / shortest) ? total / shortest : 1.0;
-  return std::max(1e-8 / std::pow(std::max(n, 1.0), 3), 1e-14);
+  return std::max(1e-8 / std::pow(std::max(n, 1.0), 3), 1e-14) * compliance;
 }
 
 // A factorized tangent. KLU factors it with the symbolic analysis of the topology's velocity-level
@@ -200,6 +206,12 @@ class TangentSolver {
     for (Eigen::Index i = 0; i < reach.size(); ++i)
       reach(i) += (i % kDofsPerBody) < 3 ? length : 1.0;
     return scaled_norm(kEps * abs_times(reach), length);
+  }
+  // What rounding leaves in the residual of a solve S dx = b: eps |S| |dx| (scaled like the
+  // residual). The minimum-norm solve of a tangent whose soft directions are many decades below
+  // its stiff ones (the penalty of a joint) leaves that much, however exact the equilibrium.
+  double solve_rounding(const Eigen::VectorXd& dx, double length) const {
+    return scaled_norm(kEps * abs_times(dx.cwiseAbs()), length);
   }
   int null_directions = 0;
   // Keep a backward-stable factorization however small its pivot ratio (arc-length control: near
@@ -355,8 +367,12 @@ struct Newton {
       singular = std::max(singular, solver.null_directions);
       Eigen::VectorXd dx = solver.solve(-w);
       if (!dx.allFinite()) return fail("the tangent stiffness is singular", false);
+      // A minimum-norm solve that leaves more of the forces than 1e-6 of them, the rounding
+      // floor and the solve's own rounding (a bob on a revolute joint at a cantilever's tip, c =
+      // 1e-6: 6e-6 of the forces, a third of eps |S| |dx|) pushes along its null directions.
       if (solver.null_directions > 0 && scaled_norm(solver.apply(dx) + w, length) >
-                                            std::max(1e-6 * scaled_norm(w, length), 10.0 * floor)) {
+                                            std::max({1e-6 * scaled_norm(w, length), 10.0 * floor,
+                                                      10.0 * solver.solve_rounding(dx, length)})) {
         // Every body held by beams: no mechanism, the tangent lost its stiffness under the
         // loads (buckling, a snap, an element at the end of its law's range); a smaller load
         // step may pass. Otherwise a free body or mechanism is pushed: no load step helps.

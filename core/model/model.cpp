@@ -74,6 +74,8 @@ bool held_by_beams(const Model& model) {
     return i;
   };
   for (const Beam& e : model.beams) parent[root(e.ends.body1)] = root(e.ends.body2);
+  for (const Joint& j : model.joints)
+    if (j.type == JointType::kFixed) parent[root(j.body1)] = root(j.body2);
   std::vector<char> grounded(model.bodies.size(), 0);
   for (size_t i = 0; i < model.bodies.size(); ++i)
     if (model.bodies[i].fixed) grounded[root(static_cast<int>(i))] = 1;

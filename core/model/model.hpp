@@ -224,8 +224,10 @@ bool applies_in_case(const LoadT<S>& load, const std::string& load_case) {
 // displacements and moments into forces where the analyses compare them.
 double characteristic_length(const Model& model);
 
-// True when every free body is joined through beams (which resist all six relative motions) to a
-// fixed body: the elastic stiffness is then positive definite (no rigid-body or mechanism mode).
+// True when every free body is joined through beams and fixed joints (which resist all six
+// relative motions) to a fixed body: the elastic stiffness is then positive definite (no rigid-body
+// or mechanism mode). Spherical and revolute joints leave rotations free and do not count: a body
+// they hang from is a pendulum, whose stiffness under no load is singular (docs/model.md "Joints").
 bool held_by_beams(const Model& model);
 
 constexpr int kStatesPerBody = 13;

@@ -16,8 +16,10 @@
 #include "core/model/element_forces.hpp"
 #include "core/model/element_kinematics.hpp"
 #include "core/model/generalized.hpp"
+#include "core/model/joint_forces.hpp"
 #include "optimizer/output/summary.hpp"
 #include "optimizer/output/tables.hpp"
+#include "optimizer/output/vtp_file.hpp"
 
 namespace beamrail {
 
@@ -25,8 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-static_assert(std::endian::native == std::endian::little,
-              "the VTK files are written little-endian, as the host's doubles are");
+using namespace vtp;  // NOLINT: the file writer of this file alone
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Points along a curve: a whole beam or rail, and one segment of a split beam (its neighbours
@@ -51,181 +52,6 @@ class Timer {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-template <class T>
-void put(std::string& bytes, T value) {
-  bytes.append(reinterpret_cast<const char*>(&value), sizeof(T));
-}
-
-void put(std::string& bytes, const Vec3& v) {
-  for (int c = 0; c < 3; ++c) put(bytes, v(c));
-}
-
-std::string vec3_bytes(const std::vector<Vec3>& points) {
-  std::string bytes;
-  bytes.reserve(points.size() * 3 * sizeof(double));
-  for (const Vec3& p : points) put(bytes, p);
-  return bytes;
-}
-
-// One DataArray of a .vtp file, its bytes in the appended section (raw, each block preceded by
-// its length as UInt64).
-struct Array {
-  std::string name;
-  const char* type = "Float64";  // Float64, Int64, Int32, UInt8 or String
-  int components = 1;
-  const std::string* bytes = nullptr;  // borrowed: lives until the file is written
-};
-
-// Cells of one kind (Verts, Lines, Polys): connectivity and end offsets, Int32 (a frame holds
-// far fewer than 2^31 points).
-struct Cells {
-  std::string connectivity, offsets;
-  long count = 0;
-  void add(const std::vector<int64_t>& points) {
-    for (int64_t p : points) put(connectivity, static_cast<int32_t>(p));
-    put(offsets, static_cast<int32_t>(connectivity.size() / sizeof(int32_t)));
-    ++count;
-  }
-};
-
-// One .vtp file: PolyData with field data, point data, cell data, points and cells.
-class Vtp {
- public:
-  void field(const std::string& name, double value) {
-    owned_.emplace_back();
-    put(owned_.back(), value);
-    field_.push_back({name, "Float64", 1, &owned_.back()});
-  }
-  void point_data(const std::string& name, const std::string* bytes, int components = 3,
-                  const char* type = "Float64") {
-    point_.push_back({name, type, components, bytes});
-  }
-  void cell_data(const std::string& name, const std::string* bytes, int components = 1,
-                 const char* type = "Float64") {
-    cell_.push_back({name, type, components, bytes});
-  }
-  void points(const std::string* bytes, long n) {
-    points_ = {"Points", "Float64", 3, bytes}, n_ = n;
-  }
-  void verts(const Cells* c) { verts_ = c; }
-  void lines(const Cells* c) { lines_ = c; }
-  void polys(const Cells* c) { polys_ = c; }
-
-  // Writes the file; false with *error naming it and the system's reason.
-  bool write(const fs::path& path, long long* written, std::string* error) const {
-    std::string xml =
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" "
-        "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PolyData>\n";
-    std::vector<const std::string*> blocks;
-    uint64_t offset = 0;
-    const auto array = [&](const Array& a, bool named) {
-      // VTK reads string arrays (null-terminated strings) from <Array>, numbers from <DataArray>.
-      xml += std::string(a.type) == "String" ? "<Array type=\"" : "<DataArray type=\"";
-      xml += a.type;
-      xml += "\"";
-      if (named) xml += " Name=\"" + a.name + "\"";
-      if (a.components != 1) xml += " NumberOfComponents=\"" + std::to_string(a.components) + "\"";
-      xml += " format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
-      blocks.push_back(a.bytes);
-      offset += sizeof(uint64_t) + a.bytes->size();
-    };
-    const auto section = [&](const char* tag, const std::vector<Array>& arrays) {
-      if (arrays.empty()) return;
-      xml += "<";
-      xml += tag;
-      xml += ">\n";
-      for (const Array& a : arrays) array(a, true);
-      xml += "</";
-      xml += tag;
-      xml += ">\n";
-    };
-    if (!field_.empty()) {
-      xml += "<FieldData>\n";
-      for (const Array& a : field_) {
-        xml += "<DataArray type=\"Float64\" Name=\"" + a.name +
-               "\" NumberOfTuples=\"1\" format=\"appended\" offset=\"" + std::to_string(offset) +
-               "\"/>\n";
-        blocks.push_back(a.bytes);
-        offset += sizeof(uint64_t) + a.bytes->size();
-      }
-      xml += "</FieldData>\n";
-    }
-    const auto count = [](const Cells* c) { return std::to_string(c ? c->count : 0); };
-    xml += "<Piece NumberOfPoints=\"" + std::to_string(n_) + "\" NumberOfVerts=\"" + count(verts_) +
-           "\" NumberOfLines=\"" + count(lines_) + "\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
-           count(polys_) + "\">\n";
-    section("PointData", point_);
-    section("CellData", cell_);
-    xml += "<Points>\n";
-    array(points_, false);
-    xml += "</Points>\n";
-    const auto cells = [&](const char* tag, const Cells* c) {
-      if (!c || c->count == 0) return;
-      xml += "<";
-      xml += tag;
-      xml += ">\n";
-      array({"connectivity", "Int32", 1, &c->connectivity}, true);
-      array({"offsets", "Int32", 1, &c->offsets}, true);
-      xml += "</";
-      xml += tag;
-      xml += ">\n";
-    };
-    cells("Verts", verts_);
-    cells("Lines", lines_);
-    cells("Polys", polys_);
-    xml += "</Piece>\n</PolyData>\n<AppendedData encoding=\"raw\">\n_";
-
-    std::FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) {
-      *error = write_error(path, errno);
-      return false;
-    }
-    bool ok = std::fwrite(xml.data(), 1, xml.size(), f) == xml.size();
-    long long total = static_cast<long long>(xml.size());
-    for (const std::string* b : blocks) {
-      if (!ok) break;
-      const uint64_t n = b->size();
-      ok = std::fwrite(&n, sizeof n, 1, f) == 1 && std::fwrite(b->data(), 1, n, f) == n;
-      total += static_cast<long long>(sizeof n + n);
-    }
-    static const std::string tail = "\n</AppendedData>\n</VTKFile>\n";
-    ok = ok && std::fwrite(tail.data(), 1, tail.size(), f) == tail.size();
-    total += static_cast<long long>(tail.size());
-    const int e = errno;
-    const bool closed = std::fclose(f) == 0;
-    if (!ok || !closed) {
-      *error = write_error(path, ok ? errno : e);
-      return false;
-    }
-    *written += total;
-    return true;
-  }
-
- private:
-  std::vector<Array> field_, point_, cell_;
-  std::list<std::string> owned_;
-  Array points_;
-  long n_ = 0;
-  const Cells *verts_ = nullptr, *lines_ = nullptr, *polys_ = nullptr;
-};
-
-// Null-terminated strings, the bytes of a VTK String array.
-std::string string_bytes(const std::vector<std::string>& strings) {
-  std::string bytes;
-  for (const std::string& s : strings) {
-    bytes += s;
-    bytes += '\0';
-  }
-  return bytes;
-}
-
-template <class T>
-std::string number_bytes(const std::vector<T>& values) {
-  std::string bytes;
-  for (T v : values) put(bytes, v);
-  return bytes;
-}
-
 }  // namespace
 
 // What a frame draws and how: the drawn bodies with their glyphs and levers, the elements with
@@ -244,12 +70,16 @@ class SceneDrawing {
     };
     for (const Beam& b : model.beams) ends(b.ends);
     for (const Rail& r : model.rails) ends(r.ends);
+    for (const Joint& j : model.joints) {
+      extend(centre(model, initial, j.body1) + initial.pose[j.body1].A * j.r1);
+      extend(centre(model, initial, j.body2) + initial.pose[j.body2].A * j.r2);
+    }
     size_ = (hi - lo).allFinite() ? (hi - lo).norm() : 0.0;
     if (!(size_ > 0.0)) size_ = characteristic_length(model);
 
     std::vector<std::string> body_names, element_names;
     std::vector<int32_t> body_index, glyph_body, element_index;
-    std::vector<uint8_t> generated, fixed, glyph_kind, element_kind;
+    std::vector<uint8_t> generated, fixed, glyph_kind, element_kind, joint_kind;
     for (size_t i = 1; i < model.bodies.size(); ++i) {
       const Body& b = model.bodies[i];
       Drawn d;
@@ -262,6 +92,10 @@ class SceneDrawing {
         };
         for (const Beam& e : model.beams) attach(e.ends);
         for (const Rail& e : model.rails) attach(e.ends);
+        for (const Joint& j : model.joints) {
+          if (j.body1 == d.body) d.levers.push_back(j.r1);
+          if (j.body2 == d.body) d.levers.push_back(j.r2);
+        }
         for (const Load& l : model.loads)
           if (l.kind == LoadKind::kForce && l.body == d.body) d.levers.push_back(l.offset);
       }
@@ -301,6 +135,7 @@ class SceneDrawing {
       for (int k = 0; k < n; ++k) c.s.push_back(static_cast<double>(k) / (n - 1));
       element_index.push_back(index);
       element_kind.push_back(rail);
+      joint_kind.push_back(0);
       curves_.push_back(c);
     };
     for (size_t i = 0; i < model.beams.size(); ++i) {
@@ -315,6 +150,18 @@ class SceneDrawing {
       curves_.back().measure = rotation_measure(r);
       curves_.back().lower = r.travel_min, curves_.back().upper = r.travel_max;
       element_names.push_back(r.name);
+    }
+    // A joint: a line from its point on body 1 to its point on body 2 (as long as its gap).
+    for (size_t i = 0; i < model.joints.size(); ++i) {
+      Curve c;
+      c.joint = true;
+      c.index = static_cast<int>(i);
+      c.s = {0.0, 1.0};
+      element_index.push_back(c.index);
+      element_kind.push_back(0);
+      joint_kind.push_back(1);
+      element_names.push_back(model.joints[i].name);
+      curves_.push_back(c);
     }
     for (Curve& c : curves_) {
       c.first = n_curve_points_;
@@ -333,6 +180,7 @@ class SceneDrawing {
     element_index_ = number_bytes(element_index);
     element_names_ = string_bytes(element_names);
     element_kind_ = number_bytes(element_kind);
+    joint_kind_ = number_bytes(joint_kind);
     place(initial, initial_);
   }
 
@@ -408,12 +256,22 @@ class SceneDrawing {
     apply_increment(model_, work, dx);
   }
 
-  // End forces of every element (beams, then rails) in the state of `data`.
-  void forces(const Data& data, std::vector<EndForces>& out, std::vector<double>& stress) const {
+  // End forces of every element (beams, then rails, then joints) in the state of `data`; the
+  // joints' gaps |p2 - p1| (NaN for beams and rails).
+  void forces(const Data& data, std::vector<EndForces>& out, std::vector<double>& stress,
+              std::vector<double>& gaps) const {
     out.resize(curves_.size());
     stress.resize(curves_.size());
+    gaps.assign(curves_.size(), kNaN);
     for (size_t k = 0; k < curves_.size(); ++k) {
       const Curve& c = curves_[k];
+      if (c.joint) {
+        const Joint& j = model_.joints[c.index];
+        out[k] = joint_end_forces(model_, data, c.index);
+        stress[k] = kNaN;
+        gaps[k] = joint_gap(j, data.pose[j.body1], data.pose[j.body2]).norm();
+        continue;
+      }
       out[k] =
           c.rail ? rail_end_forces(model_, data, c.index) : beam_end_forces(model_, data, c.index);
       stress[k] = end_stress(c.rail ? model_.rails[c.index].section : model_.beams[c.index].section,
@@ -428,7 +286,7 @@ class SceneDrawing {
   // Constant parts of the files.
   Cells centre_verts_, glyph_lines_, glyph_polys_, curve_lines_;
   std::string body_index_, body_names_, generated_, fixed_, glyph_body_, glyph_kind_,
-      element_index_, element_names_, element_kind_;
+      element_index_, element_names_, element_kind_, joint_kind_;
 
  private:
   struct Drawn {
@@ -438,6 +296,7 @@ class SceneDrawing {
   };
   struct Curve {
     bool rail = false;
+    bool joint = false;                                  // index is a joint's; ends is null
     RotationMeasure measure = RotationMeasure::kAngles;  // the element's (slopes from phi)
     int index = 0;
     const ElementEnds* ends = nullptr;
@@ -476,6 +335,12 @@ class SceneDrawing {
   // to point 2 (a rail: to the carriage, then straight on along its end slope to the travel's end
   // beyond it, and straight along the rail's axis behind point 1).
   void draw(const Curve& c, const Data& data, Vec3* out) const {
+    if (c.joint) {
+      const Joint& j = model_.joints[c.index];
+      out[0] = centre(model_, data, j.body1) + data.pose[j.body1].A * j.r1;
+      out[1] = centre(model_, data, j.body2) + data.pose[j.body2].A * j.r2;
+      return;
+    }
     const ElementEnds& e = *c.ends;
     const Pose<double>& b1 = data.pose[e.body1];
     const ElementFrames<double> f = element_frames(e, b1, data.pose[e.body2], c.measure);
@@ -523,6 +388,7 @@ struct FrameData {
   const SceneDrawing::Geometry* shape = nullptr;
   const std::vector<EndForces>* forces = nullptr;
   const std::vector<double>* stress = nullptr;
+  const std::vector<double>* gaps = nullptr;
   std::vector<std::pair<std::string, double>> fields;
 };
 
@@ -600,7 +466,8 @@ bool write_frame(const SceneDrawing& d, const SceneDrawing::Geometry& g, const F
     v.cell_data("element_index", &d.element_index_, 1, "Int32");
     v.cell_data("element", &d.element_names_, 1, "String");
     v.cell_data("rail", &d.element_kind_, 1, "UInt8");
-    std::string f1, m1, f2, m2, axial, stress;
+    v.cell_data("joint", &d.joint_kind_, 1, "UInt8");
+    std::string f1, m1, f2, m2, axial, stress, gap;
     if (data.forces) {
       for (size_t k = 0; k < data.forces->size(); ++k) {
         const EndForces& e = (*data.forces)[k];
@@ -608,8 +475,11 @@ bool write_frame(const SceneDrawing& d, const SceneDrawing::Geometry& g, const F
           put(f1, e.end1(c)), put(m1, e.end1(3 + c));
           put(f2, e.end2(c)), put(m2, e.end2(3 + c));
         }
-        put(axial, e.end2(0));
+        // A joint's gap in place of an axial force (its fx is along an axis, not a tension).
+        const double joint_gap = (*data.gaps)[k];
+        put(axial, std::isnan(joint_gap) ? e.end2(0) : kNaN);
         put(stress, (*data.stress)[k]);
+        put(gap, joint_gap);
       }
       v.cell_data("force_end1", &f1, 3);
       v.cell_data("moment_end1", &m1, 3);
@@ -617,6 +487,7 @@ bool write_frame(const SceneDrawing& d, const SceneDrawing::Geometry& g, const F
       v.cell_data("moment_end2", &m2, 3);
       v.cell_data("axial_force", &axial);
       v.cell_data("stress", &stress);
+      v.cell_data("gap", &gap);
     }
     v.lines(&d.curve_lines_);
     if (!v.write(folder / (std::string(stem) + ".elements.vtp"), written, error)) return false;
@@ -651,7 +522,7 @@ struct VtkOutput::Series {
   std::unique_ptr<SceneDrawing> drawing;
   SceneDrawing::Geometry geometry;
   std::vector<EndForces> forces;
-  std::vector<double> stress;
+  std::vector<double> stress, gaps;
   std::vector<std::pair<double, long>> frames;
 };
 
@@ -697,16 +568,17 @@ bool VtkOutput::write_static_frames(const std::string& analysis, const Model& mo
   const SceneDrawing d(model);
   const Data initial(model);
   std::vector<EndForces> forces;
-  std::vector<double> stress;
+  std::vector<double> stress, gaps;
   SceneDrawing::Geometry g;
   const fs::path folder = directory_ / analysis;
   for (int k = 0; k < 2; ++k) {
     const Data& state = k == 0 ? initial : deformed;
     d.place(state, g);
-    d.forces(state, forces, stress);
+    d.forces(state, forces, stress, gaps);
     FrameData fd;
     fd.forces = &forces;
     fd.stress = &stress;
+    fd.gaps = &gaps;
     fd.fields = {{"TimeValue", k}};
     if (!write_frame(d, g, fd, folder, k, &bytes_, error)) return false;
   }
@@ -825,10 +697,11 @@ void VtkOutput::frame(double t, const Data& data) {
   const Timer timer(&s.seconds);
   const SceneDrawing& d = *s.drawing;
   d.place(data, s.geometry);
-  d.forces(data, s.forces, s.stress);
+  d.forces(data, s.forces, s.stress, s.gaps);
   FrameData fd;
   fd.forces = &s.forces;
   fd.stress = &s.stress;
+  fd.gaps = &s.gaps;
   fd.fields = {{"TimeValue", t}};
   const long k = static_cast<long>(s.frames.size());
   std::string error;

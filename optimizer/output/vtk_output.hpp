@@ -21,6 +21,9 @@
 //                      element_forces.csv (force_end1, moment_end1, force_end2, moment_end2, in
 //                      the element frame), axial_force (fx at end 2: tension > 0) and stress (the
 //                      largest end stress of max_stress); the frames of a mode hold no forces.
+//                      Then every joint as a line from its point on body 1 to its point on body 2
+//                      (cell data joint = 1, its end forces in the joint frame, axial_force and
+//                      stress NaN, gap |p2 - p1|; gap is NaN for beams and rails).
 //
 // Frames: transient, one per output row (the frame times are the t column of timeseries.csv);
 // static, the undeformed (time 0) and the deformed state (time 1); modal and buckling, per mode a
@@ -32,11 +35,12 @@
 // design drawn).
 //
 // Written by hand, not with the VTK library. What the files hold is three small PolyData sets a
-// frame, which VTK's documented XML format (raw binary appended data) takes in ~150 lines here;
-// the library's headers (Debian libvtk9-dev) would add 149 packages and 335 MB to every machine
-// that builds beamrail, even one that already has VTK's runtime (GDAL, HDF5, NetCDF, FFmpeg, the
-// Java bindings come with it), for the same bytes. The tests read every file back with VTK's own
-// reader (python3-vtk9, installed by the test set-up only) and compare it with the tables.
+// frame, which VTK's documented XML format (raw binary appended data) takes in ~200 lines
+// (optimizer/output/vtp_file.hpp, .cpp); the library's headers (Debian libvtk9-dev) would add
+// 149 packages and 335 MB to every machine that builds beamrail, even one that already has VTK's
+// runtime (GDAL, HDF5, NetCDF, FFmpeg, the Java bindings come with it), for the same bytes. The
+// tests read every file back with VTK's own reader (python3-vtk9, installed by the test set-up
+// only) and compare it with the tables.
 #pragma once
 
 #include <filesystem>

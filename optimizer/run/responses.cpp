@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/model/element_forces.hpp"
+#include "core/model/joint_forces.hpp"
 #include "core/model/rotation.hpp"
 
 namespace beamrail {
@@ -46,9 +47,15 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
         break;
       }
       case ResponseSpec::Quantity::kElementForce: {
-        const EndForces f = r.element.rail ? rail_end_forces(model, data, r.element.index)
-                                           : beam_end_forces(model, data, r.element.index);
+        const EndForces f = r.element.joint  ? joint_end_forces(model, data, r.element.index)
+                            : r.element.rail ? rail_end_forces(model, data, r.element.index)
+                                             : beam_end_forces(model, data, r.element.index);
         values[k] = (r.element.end == 1 ? f.end1 : f.end2)(r.component);
+        break;
+      }
+      case ResponseSpec::Quantity::kJointGap: {
+        const Joint& j = model.joints[r.joint];
+        values[k] = joint_gap(j, data.pose[j.body1], data.pose[j.body2]).norm();
         break;
       }
       case ResponseSpec::Quantity::kMaxStress: {
@@ -96,9 +103,19 @@ void static_response_derivatives(const Study& study, int analysis, const Model& 
         break;
       }
       case ResponseSpec::Quantity::kElementForce: {
-        const EndForcesT<H> f = r.element.rail ? rail_end_forces(direction, pose, r.element.index)
-                                               : beam_end_forces(direction, pose, r.element.index);
+        const EndForcesT<H> f = r.element.joint ? joint_end_forces(direction, pose, r.element.index)
+                                : r.element.rail
+                                    ? rail_end_forces(direction, pose, r.element.index)
+                                    : beam_end_forces(direction, pose, r.element.index);
         values[k] = (r.element.end == 1 ? f.end1 : f.end2)(r.component).b;
+        break;
+      }
+      case ResponseSpec::Quantity::kJointGap: {
+        // d|g| = g . dg / |g|: a joint at rest (g = 0) has no derivative; 0 is given there.
+        const JointT<H>& j = direction.joints[r.joint];
+        const Vec3T<H> g = joint_gap(j, pose[j.body1], pose[j.body2]);
+        const H squared = g.dot(g);
+        values[k] = squared.v > 0.0 ? 0.5 * squared.b / std::sqrt(squared.v) : 0.0;
         break;
       }
       case ResponseSpec::Quantity::kMaxStress: {

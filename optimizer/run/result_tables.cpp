@@ -1,6 +1,7 @@
 #include "optimizer/run/result_tables.hpp"
 
 #include "core/model/element_forces.hpp"
+#include "core/model/joint_forces.hpp"
 #include "optimizer/run/number_text.hpp"
 
 namespace beamrail {
@@ -31,7 +32,19 @@ std::vector<ResultTable> static_tables(const std::string& prefix, const Model& m
     rows(model.beams[i].name, beam_end_forces(model, data, static_cast<int>(i)));
   for (size_t i = 0; i < model.rails.size(); ++i)
     rows(model.rails[i].name, rail_end_forces(model, data, static_cast<int>(i)));
-  return {std::move(displacements), std::move(forces)};
+  for (size_t i = 0; i < model.joints.size(); ++i)
+    rows(model.joints[i].name, joint_end_forces(model, data, static_cast<int>(i)));
+  std::vector<ResultTable> out{std::move(displacements), std::move(forces)};
+  if (model.joints.empty()) return out;
+  ResultTable gaps{prefix + "joint_gaps.csv", {"joint", "gap", "gx", "gy", "gz", "angle"}, {}};
+  for (const Joint& j : model.joints) {
+    const Pose<double>&b1 = data.pose[j.body1], &b2 = data.pose[j.body2];
+    const Vec3 g = joint_gap(j, b1, b2);
+    gaps.rows.push_back({j.name, format_number(g.norm()), format_number(g(0)), format_number(g(1)),
+                         format_number(g(2)), format_number(joint_angle(j, b1, b2))});
+  }
+  out.push_back(std::move(gaps));
+  return out;
 }
 
 ResultTable static_path_table(const std::string& prefix, const Model& model,

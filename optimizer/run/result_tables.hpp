@@ -25,8 +25,10 @@ struct ResultTable {
 // The tables of one analysis, their file names preceded by `prefix` ("" for an analysis named
 // after its type, else "<name>.").
 
-// static_displacements.csv (free bodies: dx, dy, dz and rotation vector rx, ry, rz) and
-// element_forces.csv (end forces of every beam and rail, element axes).
+// static_displacements.csv (free bodies: dx, dy, dz and rotation vector rx, ry, rz),
+// element_forces.csv (end forces of every beam, rail and joint, element axes: a joint's frame) and,
+// when the scene has joints, joint_gaps.csv (per joint: |p2 - p1|, p2 - p1 global, the angle of
+// core/model/joint_forces.hpp joint_angle).
 std::vector<ResultTable> static_tables(const std::string& prefix, const Model& model,
                                        const Data& data);
 

@@ -9,7 +9,7 @@ namespace beamrail {
 
 const std::vector<std::string> kResponseQuantities = {
     "frequency",  "displacement",  "rotation",        "peak_displacement", "mass",
-    "max_stress", "element_force", "buckling_factor", "expression"};
+    "max_stress", "element_force", "buckling_factor", "expression",        "joint_gap"};
 
 namespace {
 
@@ -55,12 +55,15 @@ std::optional<Vec3> unit_vector(ObjectReader& r, const std::string& key) {
   return v->normalized();
 }
 
-// Resolves an element name: a rail, a beam, or a segmented beam (its first or last segment).
+// Resolves an element name: a rail, a joint, a beam, or a segmented beam (its first or last
+// segment).
 std::optional<ElementEnd> element_named(ObjectReader& r, const Model* model, int end) {
   const auto name = r.string("element", true);
   if (!name || !model) return std::nullopt;
   for (size_t i = 0; i < model->rails.size(); ++i)
     if (model->rails[i].name == *name) return ElementEnd{true, static_cast<int>(i), end};
+  for (size_t i = 0; i < model->joints.size(); ++i)
+    if (model->joints[i].name == *name) return ElementEnd{false, static_cast<int>(i), end, true};
   int found = -1;
   for (size_t i = 0; i < model->beams.size(); ++i) {
     const Beam& b = model->beams[i];
@@ -201,7 +204,7 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
   const auto q = r.choice("quantity", true, kResponseQuantities);
   if (!q) {
     r.allow({"body", "point", "direction", "axis", "mode", "element", "component", "end",
-             "elements", "analysis", "bodies", "expression", "track", "dominant"});
+             "elements", "analysis", "bodies", "expression", "track", "dominant", "joint"});
     return std::nullopt;
   }
   if (*q == "mass") {
@@ -296,6 +299,20 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
                                    kComponents.begin());
     s.element = *element;
     return s;
+  }
+  if (*q == "joint_gap") {
+    s.quantity = ResponseSpec::Quantity::kJointGap;
+    const auto analysis = analysis_for(r, study, AnalysisSpec::Type::kStatic, *q);
+    const auto joint = r.string("joint", true);
+    if (!joint || !analysis || !model) return std::nullopt;
+    for (size_t i = 0; i < model->joints.size(); ++i)
+      if (model->joints[i].name == *joint) {
+        s.analysis = *analysis;
+        s.joint = static_cast<int>(i);
+        return s;
+      }
+    r.error("joint", "unknown joint \"" + *joint + "\"");
+    return std::nullopt;
   }
   // max_stress
   s.quantity = ResponseSpec::Quantity::kMaxStress;

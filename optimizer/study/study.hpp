@@ -51,6 +51,7 @@ struct ElementEnd {
   bool rail = false;
   int index = 0;
   int end = 1;
+  bool joint = false;  // index is a joint's (docs/model.md "Joints": forces in the joint frame)
 };
 
 struct ResponseSpec {
@@ -63,6 +64,7 @@ struct ResponseSpec {
     kMass,              // structural mass [kg]
     kMaxStress,         // static: largest |N|/S + |My|/Wy + |Mz|/Wz over beams [Pa]
     kElementForce,      // static: one component of an element's end forces [N, N m]
+    kJointGap,          // static: a joint's gap |p2 - p1| [m]
     kExpression,        // a formula over other responses (muparser syntax)
   };
   std::string name;
@@ -81,6 +83,7 @@ struct ResponseSpec {
   Vec3 direction = Vec3::UnitX();  // unit vector, global (the axis of a rotation)
   ElementEnd element;              // element_force
   int component = 0;               // element_force: 0..5 = fx, fy, fz, mx, my, mz
+  int joint = 0;                   // joint_gap: joint index
   std::vector<int> beams;          // max_stress: beam indices considered (all when empty)
   // mass: the bodies (indices) and elements (beam and rail indices) counted; all when `subset` is
   // false

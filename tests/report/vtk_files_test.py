@@ -253,6 +253,59 @@ class VtkFiles(support.TempDir):
             self.assertTrue(np.isfinite(pts).all())
             self.assertGreaterEqual(len(pts), 17)
 
+    def test_joints_are_drawn_with_their_forces_and_gaps(self):
+        # A weight W = m g hanging 0.5 m below a spherical joint to ground, and a second one on a
+        # bracket 0.5 m beside a fixed joint, both joints at the origin; no elements: each joint
+        # gives way by c d = 5e-7 m (docs/model.md "Joints": the stiffness is the weight over
+        # the joints' largest lever d, over c). The joint's line runs from its point on ground to its point
+        # on the weight; its forces are element_forces.csv's, its gap joint_gaps.csv's.
+        m, g, d = 3.0, 9.81, 0.5
+        doc = {"name": "joints",
+               "scene": {"gravity": [0, -g, 0],
+                         "bodies": [{"name": "bob", "mass": m, "inertia": [0.01, 0.02, 0.03],
+                                     "position": [0, -d, 0]},
+                                    {"name": "bracket", "mass": m, "inertia": [0.01, 0.02, 0.03],
+                                     "position": [d, 0, 0]}],
+                         "joints": [{"name": "ball", "type": "spherical", "body1": "ground",
+                                     "body2": "bob", "point": [0, 0, 0]},
+                                    {"name": "weld", "type": "fixed", "body1": "ground",
+                                     "body2": "bracket", "point": [0, 0, 0]}]},
+               "analyses": [{"type": "static"}]}
+        out = self.run_study("joints", doc, ["--vtk"])
+        times, frames = collection(os.path.join(out, "vtk", "static.pvd"))
+        e = Read(frames[times[1]]["elements"])
+        names = e.cell("element")
+        self.assertEqual(names, ["ball", "weld"])
+        self.assertEqual(list(e.cell("joint")), [1, 1])
+        self.assertEqual(list(e.cell("rail")), [0, 0])
+        forces = table(os.path.join(out, "element_forces.csv"))
+        gaps = {r["joint"]: r for r in table(os.path.join(out, "joint_gaps.csv"))}
+        lines = e.lines()
+        w = m * g
+        for k, name in enumerate(names):
+            for r in (r for r in forces if r["element"] == name):
+                f = e.cell(f"force_end{r['end']}")[k]
+                mo = e.cell(f"moment_end{r['end']}")[k]
+                self.assertEqual(list(f) + list(mo),
+                                 [float(r[c]) for c in ("fx", "fy", "fz", "mx", "my", "mz")])
+            # The joint holds the weight: -W along y at end 2, +W at end 1 (forces on the joint).
+            self.assertAlmostEqual(e.cell("force_end2")[k][1], -w, delta=1e-9 * w)
+            self.assertAlmostEqual(e.cell("force_end1")[k][1], w, delta=1e-9 * w)
+            self.assertEqual(e.cell("gap")[k], float(gaps[name]["gap"]))
+            self.assertAlmostEqual(e.cell("gap")[k] / (1e-6 * d), 1.0, delta=1e-5)
+            self.assertTrue(math.isnan(e.cell("axial_force")[k]))
+            self.assertTrue(math.isnan(e.cell("stress")[k]))
+            pts = e.points[lines[k]]
+            self.assertEqual(len(pts), 2)
+            self.assertAlmostEqual(float(np.linalg.norm(pts[1] - pts[0])), e.cell("gap")[k],
+                                   delta=1e-15)
+        # The bracket's moment W d about z, on the joint: -W d at end 2.
+        self.assertAlmostEqual(e.cell("moment_end2")[1][2], -w * d, delta=1e-9 * w * d)
+        # The undeformed frame: the joints closed, no force.
+        before = Read(frames[times[0]]["elements"])
+        self.assertEqual(list(before.cell("gap")), [0.0, 0.0])
+        self.assertEqual(float(np.abs(before.cell("force_end2")).max()), 0.0)
+
     def test_the_best_design_is_drawn_as_best_scene_json_runs(self):
         out = self.run_study("column_design", None, ["--vtk"])
         contents = load(os.path.join(out, "vtk", "contents.json"))

@@ -88,7 +88,7 @@ struct StaticResult {
   std::vector<std::string> warnings;
   // Arc-length control: the path from the unloaded start (the last point the full loads, when
   // reached), the bodies it records (the scene's own free bodies, not a beam's segment bodies;
-  // every free body when none is) and the first limit point's load factor (the first maximum of
+  // every free body when none is; the first 1000 of them, with a warning) and the first limit point's load factor (the first maximum of
   // the load factor along the path, interpolated; NaN when none was passed).
   std::vector<StaticPathPoint> path;
   std::vector<int> path_bodies;

@@ -23,6 +23,8 @@ namespace {
 constexpr double kTargetIterations = 4.0;
 // A step that fails this many halvings in a row ends the path.
 constexpr int kMaxHalvings = 20;
+// The path records at most this many bodies (its memory: 48 bytes per body and point).
+constexpr size_t kMaxPathBodies = 1000;
 
 // F = dR/dlambda at the current pose: the loads and gravity at full value (the wrench at load
 // factor 1 minus that at 0: the element forces cancel).
@@ -90,6 +92,12 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
     if (!model.bodies[model.free_bodies[k]].generated)
       result.path_bodies.push_back(model.free_bodies[k]);
   if (result.path_bodies.empty()) result.path_bodies = model.free_bodies;
+  if (result.path_bodies.size() > kMaxPathBodies) {
+    result.warnings.push_back("the load path records the first " +
+                              std::to_string(kMaxPathBodies) + " of the scene's " +
+                              std::to_string(result.path_bodies.size()) + " free bodies");
+    result.path_bodies.resize(kMaxPathBodies);
+  }
   double lambda = 0.0, s = 0.0;
   const auto finish = [&](bool ok, const std::string& message) {
     result.limit_load_factor = first_limit(result.path);

@@ -56,9 +56,9 @@ void StepFunctions::compute(double step, const Eigen::ArrayXd& lambda) {
   h = step;
   const Eigen::Index n = lambda.size();
   // Sized once (a step's functions are recomputed every step: no allocation after the first).
-  ModeFunction* used[] = {&e_half,  &e_full,  &a[1][0], &a[2][0], &a[2][1], &a[3][0], &a[3][1],
-                          &a[3][2], &a[4][0], &a[4][1], &a[4][2], &a[4][3], &b[0],    &b[3],
-                          &b[4],    &low[0],  &low[1]};
+  ModeFunction* used[] = {&e_half,  &e_full,  &a[1][0], &a[2][0], &a[2][1], &a[3][0],
+                          &a[3][1], &a[3][2], &a[4][0], &a[4][1], &a[4][2], &a[4][3],
+                          &b[0],    &b[3],    &b[4],    &low[0],  &low[1]};
   for (ModeFunction* f : used) {
     f->alpha.resize(n);
     f->beta.resize(n);

@@ -308,9 +308,8 @@ bool solve_band_modes(const Model& model, const Data& data, double t0,
       if (!r.ok) return band_fail(error, "the modal integrator's eigensolver: " + r.message);
       std::vector<size_t> order(r.modes.size());
       for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-      std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-        return r.modes[a].eigenvalue < r.modes[b].eigenvalue;
-      });
+      std::sort(order.begin(), order.end(),
+                [&](size_t a, size_t b) { return r.modes[a].eigenvalue < r.modes[b].eigenvalue; });
       values.resize(static_cast<Eigen::Index>(order.size()));
       vectors.resize(n, values.size());
       for (Eigen::Index i = 0; i < values.size(); ++i) {

@@ -509,8 +509,7 @@ class ModalExponential : public Integrator {
       }
       multiply(phi_, stage_z_, xi_);
       if (reduced_) xi_.col(0) += y_;
-      if (!nonlinear(t + StepFunctions::c[i] * f.h, stage_z_, xi_, stage_n_[i], flag))
-        return false;
+      if (!nonlinear(t + StepFunctions::c[i] * f.h, stage_z_, xi_, stage_n_[i], flag)) return false;
     }
     out.setZero(m_, 2);
     apply_add(f.e_full, lambda_, z, out);
@@ -671,12 +670,12 @@ class ModalExponential : public Integrator {
   std::vector<Vec3> c0_;
   std::vector<Vec4> q0_;
   std::vector<Mat3> a0_;
-  Block z_, x_;                   // the accepted state, modal and physical (x_ = Phi z_)
-  Block xi_, x_next_, e_;         // work space: a stage's physical state, a trial step's, its error
+  Block z_, x_;            // the accepted state, modal and physical (x_ = Phi z_)
+  Block xi_, x_next_, e_;  // work space: a stage's physical state, a trial step's, its error
   Block stage_z_, next_, difference_;  // work space: a stage's modal state, a trial step, errors
-  Eigen::VectorXd y_start_;              // work space: the quasi-static part at the accepted state
+  Eigen::VectorXd y_start_;            // work space: the quasi-static part at the accepted state
   std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote
-  Eigen::VectorXd acceleration_;  // work space: the physical accelerations of a stage
+  Eigen::VectorXd acceleration_;   // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;
   double t0_ = 0.0;  // where the run started
   StepFunctions full_;

@@ -1,12 +1,13 @@
 // Static analysis (docs/model.md "Analyses"): equilibrium of all free bodies under gravity and the
 // loads at a given time, geometrically nonlinear. The loads are raised by load steps (below) or,
-// under arc-length control, along the load-displacement path (core/analysis/static_path.cpp). Newton's method on 6 unknowns per free body
-// (centre displacement and rotation increment) with the exact tangent by automatic differentiation
-// (factored by KLU with the topology's shared symbolic analysis), full Newton steps (halved only
-// when they make the forces non-finite), and automatic load stepping when a full load step fails
-// (also when it found no equilibrium: up to 4 halvings in a row before that is the answer). The
-// tangent counts as singular against the structure's own scales (pivot_floor in the .cpp: a chain
-// of n elements has physical pivot ratios near 1 / (4 n^3)).
+// under arc-length control, along the load-displacement path (core/analysis/static_path.cpp).
+// Newton's method on 6 unknowns per free body (centre displacement and rotation increment) with the
+// exact tangent by automatic differentiation (factored by KLU with the topology's shared symbolic
+// analysis), full Newton steps (halved only when they make the forces non-finite), and automatic
+// load stepping when a full load step fails (also when it found no equilibrium: up to 4 halvings in
+// a row before that is the answer). The tangent counts as singular against the structure's own
+// scales (pivot_floor in the .cpp: a chain of n elements has physical pivot ratios near 1 / (4
+// n^3)).
 //
 // What a converged result promises (result.ok):
 //  - balance: the residual is below tolerance x the load scale, or, where rounding keeps it
@@ -88,8 +89,9 @@ struct StaticResult {
   std::vector<std::string> warnings;
   // Arc-length control: the path from the unloaded start (the last point the full loads, when
   // reached), the bodies it records (the scene's own free bodies, not a beam's segment bodies;
-  // every free body when none is; the first 1000 of them, with a warning) and the first limit point's load factor (the first maximum of
-  // the load factor along the path, interpolated; NaN when none was passed).
+  // every free body when none is; the first 1000 of them, with a warning) and the first limit
+  // point's load factor (the first maximum of the load factor along the path, interpolated; NaN
+  // when none was passed).
   std::vector<StaticPathPoint> path;
   std::vector<int> path_bodies;
   double limit_load_factor = std::numeric_limits<double>::quiet_NaN();

@@ -51,8 +51,8 @@ double largest_turn(const Eigen::VectorXd& dx) {
   return turn;
 }
 
-StaticPathPoint path_point(const Newton& n, const std::vector<int>& bodies, double lambda,
-                           double s, int iterations) {
+StaticPathPoint path_point(const Newton& n, const std::vector<int>& bodies, double lambda, double s,
+                           int iterations) {
   StaticPathPoint p;
   p.load_factor = lambda;
   p.arc_length = s;
@@ -73,7 +73,8 @@ double first_limit(const std::vector<StaticPathPoint>& path) {
     const double h1 = b.arc_length - a.arc_length, h2 = c.arc_length - b.arc_length;
     const double d1 = (b.load_factor - a.load_factor) / h1;
     const double d2 = (c.load_factor - b.load_factor) / h2;
-    const double curvature = (d2 - d1) / (h1 + h2);  // lambda = b + slope (s - sb) + curv (s - sb)^2
+    const double curvature =
+        (d2 - d1) / (h1 + h2);  // lambda = b + slope (s - sb) + curv (s - sb)^2
     const double slope = d1 + curvature * h1;
     if (!(curvature < 0.0)) return b.load_factor;
     return b.load_factor - slope * slope / (4.0 * curvature);
@@ -93,9 +94,9 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
       result.path_bodies.push_back(model.free_bodies[k]);
   if (result.path_bodies.empty()) result.path_bodies = model.free_bodies;
   if (result.path_bodies.size() > kMaxPathBodies) {
-    result.warnings.push_back("the load path records the first " +
-                              std::to_string(kMaxPathBodies) + " of the scene's " +
-                              std::to_string(result.path_bodies.size()) + " free bodies");
+    result.warnings.push_back("the load path records the first " + std::to_string(kMaxPathBodies) +
+                              " of the scene's " + std::to_string(result.path_bodies.size()) +
+                              " free bodies");
     result.path_bodies.resize(kMaxPathBodies);
   }
   double lambda = 0.0, s = 0.0;
@@ -104,8 +105,8 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
     if (!ok && lambda < 1.0) *done = lambda;  // the state is the last point's
     if (!ok) result.message = message;
     if (!ok && !std::isnan(result.limit_load_factor))
-      result.message += format("; the path passed a limit point at load factor %.6g",
-                               result.limit_load_factor);
+      result.message +=
+          format("; the path passed a limit point at load factor %.6g", result.limit_load_factor);
     return ok;
   };
   const double target = options.tolerance * f_ref;
@@ -116,8 +117,9 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
   if (!n.solver.factorize(model, data, &why)) return finish(false, why + " (at the start)");
   Eigen::VectorXd dx_f = n.solver.solve(-load_vector(n));
   if (!dx_f.allFinite() || !(motion_size(dx_f, length) > 0.0))
-    return finish(false, "the tangent stiffness at the start is singular: arc-length control "
-                         "needs a structure that carries the loads at first");
+    return finish(false,
+                  "the tangent stiffness at the start is singular: arc-length control "
+                  "needs a structure that carries the loads at first");
   // The steps are at most this long (they shorten where the path turns or Newton struggles).
   const double ds_max =
       options.arc_length > 0.0 ? options.arc_length : 0.1 * motion_size(dx_f, length);
@@ -186,10 +188,9 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
         const double root = std::sqrt(disc);
         const double q1 = (-b + root) / (2.0 * a), q2 = (-b - root) / (2.0 * a);
         // The root that keeps the direction of the step so far.
-        const double q = path_dot(base + q1 * dx_f, dx, length) >=
-                                 path_dot(base + q2 * dx_f, dx, length)
-                             ? q1
-                             : q2;
+        const double q =
+            path_dot(base + q1 * dx_f, dx, length) >= path_dot(base + q2 * dx_f, dx, length) ? q1
+                                                                                             : q2;
         Eigen::VectorXd delta = dx_r + q * dx_f;
         double dq = q;
         if (const double turn = largest_turn(delta); turn > kMaxRotationStep) {
@@ -226,8 +227,8 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
       const int before_newton = n.iterations;
       if (!n.solve(1.0, target)) {
         *done = lambda;
-        return finish(false, "the load path reached the full loads, but Newton at them failed: " +
-                                 n.failure);
+        return finish(
+            false, "the load path reached the full loads, but Newton at them failed: " + n.failure);
       }
       // Its arc length: from the step's start.
       const double s_full = s - step + motion_size(displacement(model, data) - start, length);

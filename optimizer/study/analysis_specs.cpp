@@ -183,8 +183,7 @@ bool read_static(ObjectReader& r, const Model* model, AnalysisSpec& a) {
   // How the loads are raised (docs/study_files.md "Static analysis"): load steps, or along the
   // path by arc length (through limit points; the path in static_path.csv).
   if (const auto control = r.choice("control", false, {"load", "arc_length"}))
-    a.statics.control =
-        *control == "arc_length" ? StaticControl::kArcLength : StaticControl::kLoad;
+    a.statics.control = *control == "arc_length" ? StaticControl::kArcLength : StaticControl::kLoad;
   else if (r.member("control", false))
     ok = false;
   const bool arc = a.statics.control == StaticControl::kArcLength;

@@ -62,9 +62,10 @@ TEST(StaticPathStudy, SnapThroughTrussPathAndLimitFollowTheClosedForm) {
   const nlohmann::json summary =
       nlohmann::json::parse(testing::read_text(dir / "out" / "summary.json"));
   const nlohmann::json& a = summary["analyses"][0];
-  std::printf("snap-through study: %d path points, worst %.2e P_limit off P(w), limit load factor "
-              "%.6f (closed form %.6f), lowest %.4f, final w %.6f m\n",
-              apex_rows, worst, a["limit_load_factor"].get<double>(), limit / load, lowest, last_w);
+  std::printf(
+      "snap-through study: %d path points, worst %.2e P_limit off P(w), limit load factor "
+      "%.6f (closed form %.6f), lowest %.4f, final w %.6f m\n",
+      apex_rows, worst, a["limit_load_factor"].get<double>(), limit / load, lowest, last_w);
   EXPECT_GT(apex_rows, 20);
   EXPECT_LT(worst, 5e-6);  // the joints' compliance (1e-6 of the bars' stiffness per joint)
   EXPECT_EQ(a["control"], "arc_length");

@@ -11,6 +11,17 @@ namespace beamrail::testing {
 
 inline Json vec(double x, double y, double z) { return Json::array({x, y, z}); }
 
+// A joint of `type` between bodies b1 and b2 at `point` (global); a revolute joint's "axis" is the
+// caller's to add.
+inline Json joint(const std::string& name, const std::string& type, const std::string& b1,
+                  const std::string& b2, const Vec3& point) {
+  return {{"name", name},
+          {"type", type},
+          {"body1", b1},
+          {"body2", b2},
+          {"point", vec(point(0), point(1), point(2))}};
+}
+
 // A scene built in code; every element lies along global x unless told otherwise.
 struct Scene {
   Json j = {{"materials", Json::object()}, {"sections", Json::object()}, {"bodies", Json::array()},

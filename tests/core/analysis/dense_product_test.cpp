@@ -42,8 +42,16 @@ TEST(DenseProduct, MatchesEigenAtEverySizeAroundTheBlocking) {
 TEST(DenseProduct, RectangularMatchesEigen) {
   // A band's basis (n x m, m < n) and its transpose (m x n), around the blocking of 8 columns.
   double worst = 0.0;
-  for (auto [rows, cols] : {std::pair{1, 9}, {9, 1}, {7, 3}, {3, 7}, {6, 17}, {17, 6}, {600, 95},
-                            {95, 600}, {8, 8}, {16, 7}}) {
+  for (auto [rows, cols] : {std::pair{1, 9},
+                            {9, 1},
+                            {7, 3},
+                            {3, 7},
+                            {6, 17},
+                            {17, 6},
+                            {600, 95},
+                            {95, 600},
+                            {8, 8},
+                            {16, 7}}) {
     const Eigen::MatrixXd a = Eigen::MatrixXd::Random(rows, cols);
     Eigen::MatrixXd x = Eigen::MatrixXd::Random(cols, 2);
     x.col(1) *= 1e3;

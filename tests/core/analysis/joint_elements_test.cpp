@@ -21,19 +21,11 @@ namespace beamrail {
 namespace {
 
 using testing::body_index;
+using testing::joint;
 using testing::Scene;
 using testing::vec;
 constexpr double kE = 2.1e11, kG = 8.0e10, kDensity = 7850.0, kSide = 0.01;
 constexpr double kEI = kE * kSide * kSide * kSide * kSide / 12;
-
-Json joint(const std::string& name, const std::string& type, const std::string& b1,
-           const std::string& b2, const Vec3& point) {
-  return {{"name", name},
-          {"type", type},
-          {"body1", b1},
-          {"body2", b2},
-          {"point", vec(point(0), point(1), point(2))}};
-}
 
 bool has_warning(const std::vector<std::string>& warnings, const std::string& part) {
   return std::any_of(warnings.begin(), warnings.end(),

@@ -24,18 +24,10 @@ namespace beamrail {
 namespace {
 
 using testing::body_index;
+using testing::joint;
 using testing::Scene;
 using testing::vec;
 constexpr double kPi = std::numbers::pi;
-
-Json joint(const std::string& name, const std::string& type, const std::string& b1,
-           const std::string& b2, const Vec3& point) {
-  return {{"name", name},
-          {"type", type},
-          {"body1", b1},
-          {"body2", b2},
-          {"point", vec(point(0), point(1), point(2))}};
-}
 
 Vec4 quaternion_of(const Mat3& a) {
   const Eigen::Quaterniond q(a);

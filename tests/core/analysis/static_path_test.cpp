@@ -18,8 +18,8 @@ using testing::Scene;
 using testing::vec;
 
 // Two bars of axial stiffness EA pinned (revolute joints about z) to ground at (-a, 0) and (a, 0)
-// and to each other at the apex (0, h). Pushed down by w, each bar has length L = sqrt(a^2 + (h - w)^2)
-// and compression N = EA (L0 - L) / L0, and the apex load in equilibrium is
+// and to each other at the apex (0, h). Pushed down by w, each bar has length L = sqrt(a^2 + (h -
+// w)^2) and compression N = EA (L0 - L) / L0, and the apex load in equilibrium is
 //   P(w) = 2 N (h - w) / L,
 // which rises to a limit at w1, falls through 0 at w = h (the bars in line) to -P(w1) at 2h - w1,
 // and rises again beyond: under a load above P(w1) the truss snaps through to the inverted branch.
@@ -53,12 +53,9 @@ double inverted_deflection(double p) {
 }
 
 Json pin(const std::string& name, const std::string& b1, const std::string& b2, const Vec3& p) {
-  return {{"name", name},
-          {"type", "revolute"},
-          {"body1", b1},
-          {"body2", b2},
-          {"point", vec(p(0), p(1), p(2))},
-          {"axis", vec(0, 0, 1)}};
+  Json j = testing::joint(name, "revolute", b1, b2, p);
+  j["axis"] = vec(0, 0, 1);
+  return j;
 }
 
 Model von_mises_truss(double p) {
@@ -110,7 +107,8 @@ TEST(StaticPath, VonMisesTrussSnapsThroughAlongItsClosedForm) {
   std::printf(
       "von Mises truss, P = 1.5 P_limit: %zu path points, %d steps, %d iterations; load off the "
       "closed form by at most %.2e P_limit; limit load factor %.8f (exact %.8f, %+.2e); lowest "
-      "load factor %.6f (exact %.6f); final deflection %.8f m (exact %.8f, %+.2e); sideways %.1e m\n",
+      "load factor %.6f (exact %.6f); final deflection %.8f m (exact %.8f, %+.2e); sideways %.1e "
+      "m\n",
       r.path.size(), r.load_steps, r.iterations, worst, r.limit_load_factor, limit / p,
       r.limit_load_factor - limit / p, lowest, -limit / p, w_end, w_exact, w_end - w_exact,
       sideways);
@@ -168,15 +166,16 @@ TEST(StaticPath, CantileverPathEndsAtTheLoadControlledEquilibrium) {
   ASSERT_TRUE(load.ok) << load.message;
   ASSERT_TRUE(path.ok) << path.message;
   const double difference = (by_arc.pose[tip].u - by_load.pose[tip].u).norm();
-  std::printf("cantilever, tip force: tip moved %.6f m; arc length vs load control %.2e m, %zu "
-              "points, load factors rising: %s\n",
-              by_load.pose[tip].u.norm(), difference, path.path.size(),
-              std::is_sorted(path.path.begin(), path.path.end(),
-                             [](const StaticPathPoint& a, const StaticPathPoint& b) {
-                               return a.load_factor < b.load_factor;
-                             })
-                  ? "yes"
-                  : "no");
+  std::printf(
+      "cantilever, tip force: tip moved %.6f m; arc length vs load control %.2e m, %zu "
+      "points, load factors rising: %s\n",
+      by_load.pose[tip].u.norm(), difference, path.path.size(),
+      std::is_sorted(path.path.begin(), path.path.end(),
+                     [](const StaticPathPoint& a, const StaticPathPoint& b) {
+                       return a.load_factor < b.load_factor;
+                     })
+          ? "yes"
+          : "no");
   EXPECT_GT(by_load.pose[tip].u.norm(), 0.3);
   EXPECT_LT(difference, 1e-9);
   EXPECT_TRUE(std::isnan(path.limit_load_factor));

@@ -115,6 +115,14 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
   // The first step: a tenth of the linear response to the full loads, unless given.
   compute_tangent(model, data, n.t, false, 0.0);
   if (!n.solver.factorize(model, data, &why)) return finish(false, why + " (at the start)");
+  // A mechanism (a carriage free along its rails) has no path to follow: load control solves it
+  // minimum-norm, with a warning, or finds no equilibrium.
+  if (n.solver.null_directions > 0)
+    return finish(false, "the tangent stiffness at the start has " +
+                             std::to_string(n.solver.null_directions) +
+                             " direction(s) without stiffness (a free mechanism): arc-length "
+                             "control needs a structure that carries the loads at first; use "
+                             "\"control\": \"load\"");
   Eigen::VectorXd dx_f = n.solver.solve(-load_vector(n));
   if (!dx_f.allFinite() || !(motion_size(dx_f, length) > 0.0))
     return finish(false,
@@ -223,6 +231,9 @@ bool follow_path(Newton& n, const StaticOptions& options, double f_ref, StaticRe
                                             0.5, 2.0));
     if (lambda >= 1.0 && before < 1.0) {
       // The full loads lie on this step: their equilibrium by Newton from its end.
+      // With the checks of load control (a nearly singular tangent solved minimum-norm and
+      // judged: the equilibrium must not lean on a direction without stiffness).
+      n.solver.keep_near_singular = false;
       n.failure.clear();
       const int before_newton = n.iterations;
       if (!n.solve(1.0, target)) {

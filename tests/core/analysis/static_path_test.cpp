@@ -186,5 +186,30 @@ TEST(StaticPath, CantileverPathEndsAtTheLoadControlledEquilibrium) {
   EXPECT_EQ(path.path_bodies[0], tip);
 }
 
+TEST(StaticPath, AFreeMechanismIsRefusedWithTheReason) {
+  // A carriage on a prismatic rail (no stiffness along it) pushed across the rail: load control
+  // finds no equilibrium (the bent rail's slope pushes the carriage along it); arc-length control
+  // has no path along a mechanism and says so at the start instead of following one.
+  Scene s;
+  s.material("steel", 2.1e11, 8.1e10);
+  s.square("sq10", 0.01);
+  s.body("carriage", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.5, 0, 0));
+  s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.5, 0, 0), "steel",
+         "sq10");
+  s.force("carriage", Vec3(0, -10, 0));
+  const Model model = s.model();
+  Data by_load(model), by_arc(model);
+  const StaticResult load = solve_static(model, StaticOptions{}, by_load);
+  StaticOptions arc;
+  arc.control = StaticControl::kArcLength;
+  const StaticResult path = solve_static(model, arc, by_arc);
+  std::printf("carriage on a rail: load control: %s; arc length: %s\n", load.message.c_str(),
+              path.message.c_str());
+  EXPECT_FALSE(load.ok);
+  EXPECT_FALSE(path.ok);
+  EXPECT_TRUE(path.path.empty() && path.load_steps == 0);  // refused before any step
+  EXPECT_NE(path.message.find("without stiffness"), std::string::npos) << path.message;
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -14,6 +14,7 @@
 
 #include "core/scene/json_reader.hpp"
 #include "optimizer/run/designs.hpp"
+#include "tests/support/design_differences.hpp"
 
 namespace beamrail {
 namespace {
@@ -71,16 +72,6 @@ TEST(JointSensitivities, EveryResponseAgainstEveryVariableMatchesExtrapolatedDif
   double worst = 0.0, worst_small = 0.0;
   int compared = 0;
   for (size_t j = 0; j < x.size(); ++j) {
-    const auto central = [&](double h) {
-      std::vector<double> up = x, down = x;
-      up[j] += h, down[j] -= h;
-      const DesignOutcome u = evaluator.evaluate(up), d = evaluator.evaluate(down);
-      EXPECT_EQ(u.status, Status::kOk) << u.message;
-      EXPECT_EQ(d.status, Status::kOk) << d.message;
-      std::vector<double> out(nr);
-      for (size_t k = 0; k < nr; ++k) out[k] = (u.responses[k] - d.responses[k]) / (2 * h);
-      return out;
-    };
     // Central differences at steps 2e-3 and 1e-3 (relative), extrapolated (Richardson). A joint's
     // force is its stiffness times a gap of ~1e-7 m: its rounding grows with the stiffness, which
     // is why the joints here are soft (relative compliance 0.1: ten times the stiffest element's
@@ -88,10 +79,10 @@ TEST(JointSensitivities, EveryResponseAgainstEveryVariableMatchesExtrapolatedDif
     // 309 against the exact 221.07, which moved by 1.2e-5 from c = 1e-4 to 0.1 while the
     // differences converged on it); at c = 0.1 they resolve them to 1.3e-6 at these steps (7.8e-8
     // at steps 5 times larger, where the frequencies' truncation error grows to 2.7e-4).
-    const double h = 2e-3 * std::abs(x[j]);
-    const std::vector<double> a = central(h), b = central(h / 2);
+    const std::vector<double> differences =
+        testing::extrapolated_differences(evaluator, x, j, 2e-3 * std::abs(x[j]), nr);
     for (size_t k = 0; k < nr; ++k) {
-      const double reference = (4 * b[k] - a[k]) / 3;
+      const double reference = differences[k];
       const double exact = s.jacobian(k, j);
       // As in tests/optimizer/sensitivities_test.cpp: relative agreement where the response
       // changes by at least a tenth of the variable's relative change, absolute (1e-6 |r / x|)

@@ -19,6 +19,7 @@
 #include "core/scene/json_reader.hpp"
 #include "optimizer/run/designs.hpp"
 #include "tests/support/closed_forms.hpp"
+#include "tests/support/design_differences.hpp"
 
 namespace beamrail {
 namespace {
@@ -235,20 +236,10 @@ TEST(Sensitivities, EveryResponseKindAgainstEveryVariableKindMatchesExtrapolated
   for (size_t j = 0; j < x.size(); ++j) {
     // Central differences at steps 1e-3 and 5e-4 (relative), extrapolated: error ~1e-12
     // relative plus the analyses' rounding over the step.
-    const auto central = [&](double h) {
-      std::vector<double> up = x, down = x;
-      up[j] += h, down[j] -= h;
-      const DesignOutcome u = evaluator.evaluate(up), d = evaluator.evaluate(down);
-      EXPECT_EQ(u.status, Status::kOk) << u.message;
-      EXPECT_EQ(d.status, Status::kOk) << d.message;
-      std::vector<double> out(nr);
-      for (size_t k = 0; k < nr; ++k) out[k] = (u.responses[k] - d.responses[k]) / (2 * h);
-      return out;
-    };
-    const double h = 1e-3 * std::abs(x[j]);
-    const std::vector<double> a = central(h), b = central(h / 2);
+    const std::vector<double> differences =
+        testing::extrapolated_differences(evaluator, x, j, 1e-3 * std::abs(x[j]), nr);
     for (size_t k = 0; k < nr; ++k) {
-      const double reference = (4 * b[k] - a[k]) / 3;
+      const double reference = differences[k];
       const double exact = r.s.jacobian(k, j);
       // The responses carry rounding errors of ~1e-11 of their value (an element force from a
       // strain of 1e-5 measured on positions of 1 m), so a derivative is resolved to about that

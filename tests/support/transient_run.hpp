@@ -46,6 +46,21 @@ inline double motion_error(const TransientRun& run, const TransientRun& referenc
   return error / motion;
 }
 
+// Largest distance between the runs' free-body centres over the common samples, relative to the
+// largest distance a body moved in the reference (the work-precision study's measure).
+inline double run_error(const Model& model, const TransientRun& run,
+                        const TransientRun& reference) {
+  double error = 0.0, motion = 0.0;
+  for (int b : model.free_bodies) {
+    const Vec3 start = reference.samples.front().c[b];
+    for (const auto& s : reference.samples) motion = std::max(motion, (s.c[b] - start).norm());
+    const size_t n = std::min(run.samples.size(), reference.samples.size());
+    for (size_t k = 0; k < n; ++k)
+      error = std::max(error, (run.samples[k].c[b] - reference.samples[k].c[b]).norm());
+  }
+  return error / motion;
+}
+
 inline TransientOptions options(double t_end, double output_step, double rtol, double atol) {
   TransientOptions o;
   o.t_end = t_end;

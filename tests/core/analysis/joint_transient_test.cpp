@@ -14,23 +14,10 @@ namespace beamrail {
 namespace {
 
 using testing::options;
+using testing::run_error;
 using testing::scene_from_json;
 using testing::simulate;
 using testing::TransientRun;
-
-// Largest distance between the runs' free-body centres over the common samples, relative to the
-// largest distance a body moved in the reference.
-double error_of(const Model& model, const TransientRun& run, const TransientRun& reference) {
-  double error = 0.0, motion = 0.0;
-  for (int b : model.free_bodies) {
-    const Vec3 start = reference.samples.front().c[b];
-    for (const auto& s : reference.samples) motion = std::max(motion, (s.c[b] - start).norm());
-    const size_t n = std::min(run.samples.size(), reference.samples.size());
-    for (size_t k = 0; k < n; ++k)
-      error = std::max(error, (run.samples[k].c[b] - reference.samples[k].c[b]).norm());
-  }
-  return error / motion;
-}
 
 TransientRun run_with(const Model& model, const std::string& method, double t_end,
                       double output_step, double rtol) {
@@ -85,12 +72,12 @@ TEST(JointTransient, AutoAndModalFollowTheirToleranceWithJoints) {
     const TransientRun check = run_with(model, "bdf", c.t_end, 1e-3, 1e-10);
     ASSERT_TRUE(check.result.ok) << check.result.message;
     std::printf("%s: bdf reference at rtol 1e-11, %ld steps; at rtol 1e-10 it differs by %.2e\n",
-                c.label, reference.result.stats.steps, error_of(model, check, reference));
+                c.label, reference.result.stats.steps, run_error(model, check, reference));
     for (const char* method : {"auto", "modal"}) {
       for (double rtol : {1e-5, 1e-7}) {
         const TransientRun run = run_with(model, method, c.t_end, 1e-3, rtol);
         ASSERT_TRUE(run.result.ok) << c.label << ", " << method << ": " << run.result.message;
-        const double e = error_of(model, run, reference);
+        const double e = run_error(model, run, reference);
         std::printf("  %s, rtol %.0e: error %.2e = %.3f rtol, %ld steps, %ld phases\n", method,
                     rtol, e, e / rtol, run.result.stats.steps, run.result.phase_count);
         for (const MethodPhase& p : run.result.phases)

@@ -18,23 +18,10 @@ namespace {
 
 using testing::options;
 using testing::reference_cantilever;
+using testing::run_error;
 using testing::scene_from_json;
 using testing::simulate;
 using testing::TransientRun;
-
-// Largest distance between the runs' free-body centres over the common samples, relative to the
-// largest distance a body moved in the reference (the work-precision study's measure).
-double error_of(const Model& model, const TransientRun& run, const TransientRun& reference) {
-  double error = 0.0, motion = 0.0;
-  for (int b : model.free_bodies) {
-    const Vec3 start = reference.samples.front().c[b];
-    for (const auto& s : reference.samples) motion = std::max(motion, (s.c[b] - start).norm());
-    const size_t n = std::min(run.samples.size(), reference.samples.size());
-    for (size_t k = 0; k < n; ++k)
-      error = std::max(error, (run.samples[k].c[b] - reference.samples[k].c[b]).norm());
-  }
-  return error / motion;
-}
 
 TransientRun tight(const Model& model, double t_end, double output_step, double rtol = 1e-11) {
   TransientOptions o = options(t_end, output_step, rtol, 1e-2 * rtol);
@@ -71,7 +58,7 @@ TEST(TransientAuto, PointMassTipTakesTheModalMethod) {
   for (double rtol : {1e-8, 1e-11}) {
     const TransientRun run = run_with(model, "auto", 0.05, 1e-3, rtol);
     ASSERT_TRUE(run.result.ok) << run.result.message;
-    const double e = error_of(model, run, reference);
+    const double e = run_error(model, run, reference);
     std::printf("point-mass tip, auto, rtol %.0e: error %.2e, %ld steps (reference: %ld)\n", rtol,
                 e, run.result.stats.steps, reference.result.stats.steps);
     ASSERT_EQ(run.result.phases.size(), 1u);
@@ -108,7 +95,7 @@ TEST(TransientAuto, StiffHingePendulumRelinearizes) {
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
   const TransientRun run = run_with(*model, "auto", t_end, 1e-2, 1e-6);
   ASSERT_TRUE(run.result.ok) << run.result.message;
-  const double e = error_of(*model, run, reference);
+  const double e = run_error(*model, run, reference);
   std::printf(
       "stiff-hinge pendulum, auto, rtol 1e-6, %.1f s: error %.2e, %ld steps, %ld phases "
       "(reference: %ld steps)\n",
@@ -147,7 +134,7 @@ TEST(TransientAuto, FastSpinStaysWithTheModalMethod) {
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
   const TransientRun run = run_with(model, "auto", t_end, 1e-2, rtol);
   ASSERT_TRUE(run.result.ok) << run.result.message;
-  const double e = error_of(model, run, reference);
+  const double e = run_error(model, run, reference);
   const double e0 = run.samples.front().sample.energy();
   double change = 0.0;
   for (const auto& s : run.samples) change = std::max(change, std::abs(s.sample.energy() / e0 - 1));
@@ -185,7 +172,7 @@ TEST(TransientAuto, ErrorFollowsTheTolerance) {
     for (double rtol : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) {
       const TransientRun run = run_with(c.model, "auto", c.t_end, 1e-3, rtol);
       ASSERT_TRUE(run.result.ok) << c.label << ": " << run.result.message;
-      const double e = error_of(c.model, run, reference);
+      const double e = run_error(c.model, run, reference);
       std::printf("%s, rtol %.0e: error %.2e = %.3f rtol, %ld steps, %ld phases\n", c.label, rtol,
                   e, e / rtol, run.result.stats.steps, run.result.phase_count);
       EXPECT_GT(e, 1e-3 * rtol) << c.label << " rtol " << rtol;
@@ -283,14 +270,14 @@ TEST(TransientBand, ErrorShrinksAsTheBandWidens) {
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
   const TransientRun full = run_with(model, "modal", 0.1, 1e-3, 1e-7);
   ASSERT_TRUE(full.result.ok) << full.result.message;
-  const double full_error = error_of(model, full, reference);
+  const double full_error = run_error(model, full, reference);
   std::printf("full model, rtol 1e-7: error %.2e, %ld steps\n", full_error,
               full.result.stats.steps);
   double previous = 1.0;
   for (double band : {20.0, 100.0, 500.0, 2000.0}) {
     const TransientRun run = run_with(model, "modal", 0.1, 1e-3, 1e-7, band);
     ASSERT_TRUE(run.result.ok) << band << " Hz: " << run.result.message;
-    const double e = error_of(model, run, reference);
+    const double e = run_error(model, run, reference);
     std::printf("band %6.0f Hz, rtol 1e-7: error %.2e against the full model, %ld steps, %ld rhs\n",
                 band, e, run.result.stats.steps, run.result.stats.rhs_evaluations);
     EXPECT_LT(e, 0.5 * previous) << band;
@@ -303,7 +290,7 @@ TEST(TransientBand, ErrorShrinksAsTheBandWidens) {
   const TransientRun all = run_with(model, "modal", 0.1, 1e-3, 1e-7, 1e9);
   ASSERT_TRUE(all.result.ok) << all.result.message;
   EXPECT_EQ(all.result.stats.steps, full.result.stats.steps);
-  EXPECT_LT(error_of(model, all, full), 1e-9);
+  EXPECT_LT(run_error(model, all, full), 1e-9);
 }
 
 }  // namespace

@@ -34,6 +34,10 @@ bool change_after(const TimeFunction& f, double t0, double* rate, double* factor
       *rate = f.to > f.from ? kinks / (f.to - f.from) : 0.0;
       return true;
     }
+    case TimeFunction::Type::kSmoothRamp:  // one cycle of a cosine in its acceleration
+      if (f.to <= t0) return false;
+      *rate = 2.0 * std::numbers::pi / (f.to - f.from);
+      return true;
     case TimeFunction::Type::kHarmonic:
       *rate = 2.0 * std::numbers::pi * std::abs(f.frequency);
       return f.frequency != 0.0;

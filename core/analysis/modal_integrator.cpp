@@ -69,6 +69,10 @@ class ModalExponential : public Integrator {
     const Model& model = c.model;
     n_ = model.n_dofs;
     if (n_ == 0) return fail(error, "the modal integrator needs at least one free body");
+    if (!model.driven_bodies.empty())
+      return fail(error, "body \"" + model.bodies[model.driven_bodies.front()].name +
+                             "\" moves as prescribed: the modal method vibrates about one fixed "
+                             "configuration; use bdf or dirk");
     band_hz_ = o.max_frequency_hz;
     if (n_ > kModalIntegratorMaxDofs && !(band_hz_ > 0.0) && !o.choose_band)
       return fail(error, "the modal integrator handles up to " +

@@ -19,6 +19,7 @@ namespace {
 
 TransientSample sample_at(const Model& model, Data& data, double t, const double* y) {
   set_state(model, data, y);
+  set_driven_poses(model, data, t);
   compute_wrenches(model, data, t);
   TransientSample s;
   s.t = t;
@@ -28,9 +29,13 @@ TransientSample sample_at(const Model& model, Data& data, double t, const double
   return s;
 }
 
-std::vector<double> load_breakpoints(const Model& model, double t_end) {
+std::vector<double> time_breakpoints(const Model& model, double t_end) {
   std::vector<double> all, inside;
   for (const Load& load : model.loads) load.time.append_breakpoints(all);
+  for (int i : model.driven_bodies) {  // a drive's velocity jumps or kinks there
+    model.bodies[i].motion.velocity_time.append_breakpoints(all);
+    model.bodies[i].motion.angular_velocity_time.append_breakpoints(all);
+  }
   std::sort(all.begin(), all.end());
   for (double t : all)
     if (t > 0.0 && t < t_end && (inside.empty() || t > inside.back())) inside.push_back(t);
@@ -174,7 +179,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     };
     deliver(0.0);
 
-    const std::vector<double> breakpoints = load_breakpoints(model, options.t_end);
+    const std::vector<double> breakpoints = time_breakpoints(model, options.t_end);
     size_t next_break = 0;
     const long n_out =
         std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));

@@ -39,6 +39,22 @@ void set_state(const Model& model, Data& data, const double* y) {
   }
 }
 
+void set_driven_poses(const Model& model, Data& data, double t) {
+  for (int i : model.driven_bodies) {
+    const Body& b = model.bodies[i];
+    const PrescribedMotion& m = b.motion;
+    Pose<double>& p = data.pose[i];
+    p.u = m.velocity * m.velocity_time.integral(t);
+    p.v = m.velocity * m.velocity_time(t);
+    const Vec4 q0 = b.orientation / b.orientation.norm();
+    data.q[i] = quat_multiply(
+        quat_from_rotation_vector(m.angular_velocity * m.angular_velocity_time.integral(t)), q0);
+    p.A = rotation_matrix<double>(data.q[i]);
+    p.omega = m.angular_velocity * m.angular_velocity_time(t);
+    data.w[i] = p.A.transpose() * p.omega;
+  }
+}
+
 void initial_state(const Model& model, double* y) {
   for (int k = 0; k < model.n_free(); ++k) {
     const Body& b = model.bodies[model.free_bodies[k]];

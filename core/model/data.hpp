@@ -44,6 +44,10 @@ inline Vec3 centre(const Model& model, const Data& data, int i) {
 // Sets pose, q and w of the free bodies from a state vector y (dim model.n_states).
 void set_state(const Model& model, Data& data, const double* y);
 
+// Sets pose, q and w of the driven bodies (model.driven_bodies) at time t [s] from their
+// prescribed motion (core/model/motion.hpp). Every analysis of motion calls it with set_state.
+void set_driven_poses(const Model& model, Data& data, double t);
+
 // Writes the initial state of the free bodies into y (dim model.n_states).
 void initial_state(const Model& model, double* y);
 

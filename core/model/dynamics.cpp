@@ -9,6 +9,7 @@ namespace beamrail {
 
 void state_derivative(const Model& model, Data& data, double t, const double* y, double* ydot) {
   set_state(model, data, y);
+  set_driven_poses(model, data, t);
   compute_wrenches(model, data, t);
   for (int k = 0; k < model.n_free(); ++k) {
     const int i = model.free_bodies[k];
@@ -28,6 +29,7 @@ void state_derivative(const Model& model, Data& data, double t, const double* y,
 void state_jacobian_blocks(const Model& model, Data& data, double t, const double* y,
                            std::vector<Mat13>& blocks) {
   set_state(model, data, y);
+  set_driven_poses(model, data, t);
   compute_wrenches(model, data, t);
   const bool damped = has_damping(model);
   compute_tangent(model, data, t, damped);

@@ -29,8 +29,10 @@ std::array<int, 4> couple(const std::vector<BodyT<S>>& bodies,
 template <class S>
 void ModelT<S>::finalize() {
   free_bodies.clear();
+  driven_bodies.clear();
   for (int i = 0; i < static_cast<int>(bodies.size()); ++i) {
     BodyT<S>& b = bodies[i];
+    if (b.driven) driven_bodies.push_back(i);
     b.free_index = b.fixed ? -1 : static_cast<int>(free_bodies.size());
     if (!b.fixed) free_bodies.push_back(i);
   }

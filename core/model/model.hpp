@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/model/motion.hpp"
 #include "core/model/time_function.hpp"
 #include "core/model/types.hpp"
 
@@ -27,7 +28,9 @@ struct BodyT {
   Vec4T<S> orientation = Vec4T<S>(1, 0, 0, 0);  // initial Euler parameters (body -> global)
   Vec3T<S> velocity = Vec3T<S>::Zero();  // initial velocity of the centre of mass, global [m/s]
   Vec3T<S> angular_velocity = Vec3T<S>::Zero();  // initial angular velocity, body axes [rad/s]
-  bool fixed = false;
+  bool fixed = false;      // true also for a driven body: no analysis solves for its motion
+  bool driven = false;     // moved as `motion` prescribes (core/model/motion.hpp); fixed too
+  PrescribedMotion motion;
   bool generated = false;  // interior body of a segmented beam
   S declared_mass = 0.0;   // the mass given in the scene, before segment masses
   int free_index = -1;     // position among the free bodies, -1 if fixed
@@ -175,7 +178,8 @@ struct ModelT {
   std::vector<std::string> load_cases;         // the names loads give as their case, in scene order
   std::vector<SegmentChoice> segment_choices;  // of the beams with "segments": "auto"
 
-  std::vector<int> free_bodies;  // body index of each free body, in state order
+  std::vector<int> free_bodies;    // body index of each free body, in state order
+  std::vector<int> driven_bodies;  // body index of each driven body
   int n_states = 0;              // 13 per free body: c(3), q(4), v(3), w(3)
   int n_dofs = 0;                // 6 per free body: dc(3), dtheta(3)
   BlockPattern pattern;
@@ -207,6 +211,7 @@ ModelT<S> with_loads(const ModelT<S>& model, Keep&& keep, bool gravity) {
   out.load_cases = model.load_cases;
   out.segment_choices = model.segment_choices;
   out.free_bodies = model.free_bodies;
+  out.driven_bodies = model.driven_bodies;
   out.n_states = model.n_states;
   out.n_dofs = model.n_dofs;
   out.pattern = model.pattern;

@@ -60,6 +60,7 @@ ModelT<T> zip_numbers(F&& f, const ModelT<S0>& first, const ModelT<S>&... others
     const BodyT<S0>& b0 = first.bodies[i];
     BodyT<T>& o = out.bodies[i];
     o.name = b0.name, o.fixed = b0.fixed, o.generated = b0.generated;
+    o.driven = b0.driven, o.motion = b0.motion;
     o.free_index = b0.free_index;
     number(f, o.mass, b0.mass, others.bodies[i].mass...);
     number(f, o.inertia, b0.inertia, others.bodies[i].inertia...);
@@ -140,6 +141,7 @@ ModelT<T> zip_numbers(F&& f, const ModelT<S0>& first, const ModelT<S>&... others
   out.load_cases = first.load_cases;
   out.segment_choices = first.segment_choices;
   out.free_bodies = first.free_bodies;
+  out.driven_bodies = first.driven_bodies;
   out.n_states = first.n_states;
   out.n_dofs = first.n_dofs;
   out.pattern = first.pattern;

@@ -384,6 +384,8 @@ std::optional<ModelT<S>> build_scene(const Json& scene, const Where& where, Diag
     BodyT<S> b;
     b.name = s.name;
     b.fixed = s.fixed;
+    b.driven = s.driven;
+    b.motion = s.motion;
     b.generated = s.generated;
     b.declared_mass = b.generated ? S(0.0) : s.mass.value_or(S(0.0));
     b.orientation = s.orientation;

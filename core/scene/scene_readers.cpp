@@ -149,7 +149,8 @@ std::optional<TimeFunctionT<S>> read_time_function(const Json& value, const Wher
   using TimeFunction = TimeFunctionT<S>;
   const auto number = [&](const std::string& key, double x) { return seeded(specs, x, r.at(key)); };
   TimeFunction f;
-  const auto type = r.choice("type", true, {"constant", "step", "ramp", "harmonic", "table"});
+  const auto type =
+      r.choice("type", true, {"constant", "step", "ramp", "smooth_ramp", "harmonic", "table"});
   if (!type) {
     r.allow({"at", "from", "to", "frequency", "phase", "t", "v"});
     return std::nullopt;
@@ -160,8 +161,8 @@ std::optional<TimeFunctionT<S>> read_time_function(const Json& value, const Wher
     f.at = number("at", r.number_or("at", 0.0));
     return f;
   }
-  if (*type == "ramp") {
-    f.type = TimeFunction::Type::kRamp;
+  if (*type == "ramp" || *type == "smooth_ramp") {
+    f.type = *type == "ramp" ? TimeFunction::Type::kRamp : TimeFunction::Type::kSmoothRamp;
     const auto from = r.number("from", true), to = r.number("to", true);
     if (!from || !to) return std::nullopt;
     if (*to <= *from) {
@@ -278,6 +279,46 @@ void read_sections(ObjectReader& scene, SceneSpecsT<S>& specs) {
   });
 }
 
+// A driven body's "motion": {"velocity": [..], "velocity_time": {..}, "angular_velocity": [..],
+// "angular_velocity_time": {..}} (core/model/motion.hpp); the time functions default to constant.
+template <class S>
+std::optional<PrescribedMotion> read_motion(const Json& value, const Where& where,
+                                            Diagnostics& diag, const SceneSpecsT<S>& specs) {
+  ObjectReader r(value, where, diag);
+  if (!r.is_object()) return std::nullopt;
+  PrescribedMotion m;
+  const auto velocity = r.vec3("velocity", false);
+  const auto angular_velocity = r.vec3("angular_velocity", false);
+  bool ok = true;
+  const auto time = [&](const std::string& key, TimeFunction& out) {
+    const Json* t = r.member(key, false);
+    if (!t) return;
+    const std::optional<TimeFunctionT<S>> f = read_time_function(*t, where / key, diag, specs);
+    if (!f) {
+      ok = false;
+      return;
+    }
+    out.type = static_cast<TimeFunction::Type>(f->type);
+    out.at = value_of(f->at), out.from = value_of(f->from), out.to = value_of(f->to);
+    out.frequency = value_of(f->frequency), out.phase = value_of(f->phase);
+    for (const S& x : f->t) out.t.push_back(value_of(x));
+    for (const S& x : f->v) out.v.push_back(value_of(x));
+  };
+  time("velocity_time", m.velocity_time);
+  time("angular_velocity_time", m.angular_velocity_time);
+  if (!r.member("velocity", false) && !r.member("angular_velocity", false)) {
+    diag.error(where.file, where.pointer,
+               "a motion needs \"velocity\" or \"angular_velocity\" (or both)");
+    return std::nullopt;
+  }
+  if ((r.member("velocity", false) && !velocity) ||
+      (r.member("angular_velocity", false) && !angular_velocity) || !ok)
+    return std::nullopt;
+  if (velocity) m.velocity = *velocity;
+  if (angular_velocity) m.angular_velocity = *angular_velocity;
+  return m;
+}
+
 template <class S>
 void read_bodies(ObjectReader& scene, SceneSpecsT<S>& specs) {
   BodySpecT<S> ground;
@@ -320,6 +361,18 @@ void read_bodies(ObjectReader& scene, SceneSpecsT<S>& specs) {
       }
     }
     // Only when the other one is absent (an invalid one was reported already).
+    if (const Json* motion = r.member("motion", false)) {
+      if (const auto m = read_motion(*motion, r.at("motion"), diag, specs)) {
+        b.driven = true;
+        b.motion = *m;
+      }
+      if (b.fixed) r.error("fixed", "a body with a \"motion\" is driven, not fixed: drop one");
+      for (const char* key : {"velocity", "angular_velocity"})
+        if (r.member(key, false))
+          r.error(key, std::string("a driven body's velocities are its \"motion\"'s: drop \"") +
+                           key + "\"");
+      b.fixed = true;  // no analysis solves for its motion
+    }
     const bool has_mass = r.member("mass", false), has_inertia = r.member("inertia", false);
     if (b.mass && !has_inertia && !b.fixed)
       r.error("inertia", "a free body with a mass needs an inertia");
@@ -504,8 +557,9 @@ void read_loads(ObjectReader& scene, SceneSpecsT<S>& specs) {
     if (const Json* t = r.member("time", false))
       time = read_time_function(*t, at / "time", diag, specs);
     if (body && specs.bodies[*body].fixed) {
-      r.error("body",
-              "body \"" + specs.bodies[*body].name + "\" is fixed: a load on it does nothing");
+      r.error("body", "body \"" + specs.bodies[*body].name + "\" is " +
+                          (specs.bodies[*body].driven ? "driven by its \"motion\"" : "fixed") +
+                          ": a load on it does nothing");
       return;
     }
     if (!type || !body || !value || !time || follows_bad || (load_case && load_case->empty()))

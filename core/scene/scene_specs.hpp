@@ -26,8 +26,10 @@ template <class S>
 struct BodySpecT {
   std::string name;
   Where where;
-  bool fixed = false;
-  bool generated = false;  // interior node of a segmented beam
+  bool fixed = false;       // true also for a driven body
+  bool driven = false;      // moved as `motion` prescribes
+  PrescribedMotion motion;  // (core/model/motion.hpp)
+  bool generated = false;   // interior node of a segmented beam
   std::optional<S> mass;
   std::optional<Mat3T<S>> inertia;  // body axes
   Vec3T<S> position = Vec3T<S>::Zero();

@@ -15,6 +15,12 @@ PointTracker::PointTracker(const Model& model, const ResponseSpec& spec)
   const Body& b = model.bodies[spec.body];
   initial_lever_ = spec.point - b.position;
   offset_ = rotation_matrix<double>(b.orientation).transpose() * initial_lever_;
+  if (spec.relative_to >= 0) {
+    const Body& f = model.bodies[spec.relative_to];
+    frame_ = spec.relative_to;
+    frame_orientation_ = rotation_matrix<double>(f.orientation);
+    initial_in_frame_ = spec.point - f.position;
+  }
 }
 
 namespace {
@@ -30,7 +36,14 @@ S point_displacement(const Pose<S>& p, const Vec3T<S>& offset, const Vec3T<S>& l
 }  // namespace
 
 double PointTracker::value(const Data& data) const {
-  return point_displacement(data.pose[body_], offset_, initial_lever_, direction_);
+  if (frame_ < 0) return point_displacement(data.pose[body_], offset_, initial_lever_, direction_);
+  // The point's position from the reference body's centre, turned back by the body's rotation
+  // since the start (A0 A^T): its displacement as an observer riding on that body sees it.
+  const Pose<double>& p = data.pose[body_];
+  const Pose<double>& f = data.pose[frame_];
+  const Vec3 moved = p.u + p.A * offset_ - initial_lever_;  // global displacement of the point
+  const Vec3 seen = frame_orientation_ * (f.A.transpose() * (initial_in_frame_ + moved - f.u));
+  return (seen - initial_in_frame_).dot(direction_);
 }
 
 void static_responses(const Study& study, int analysis, const Model& model, const Data& data,

@@ -51,6 +51,11 @@ class PointTracker {
   Vec3 offset_;         // body axes
   Vec3 initial_lever_;  // point - centre in the initial configuration, global
   Vec3 direction_;
+  // With spec.relative_to: the reference body, its initial orientation, and the point's initial
+  // position from its centre (global).
+  int frame_ = -1;
+  Mat3 frame_orientation_ = Mat3::Identity();
+  Vec3 initial_in_frame_ = Vec3::Zero();
 };
 
 // Fills the static responses (displacement, rotation, element_force, max_stress) of analysis

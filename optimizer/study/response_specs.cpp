@@ -267,7 +267,18 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
     const auto body = body_named(r, "body", model);
     const auto point = r.vec3("point", false);
     const auto direction = unit_vector(r, "direction");
+    std::optional<int> relative_to;
+    if (r.member("relative_to", false)) {
+      if (s.quantity == ResponseSpec::Quantity::kPeakDisplacement) {
+        relative_to = body_named(r, "relative_to", model);
+        if (!relative_to) return std::nullopt;
+      } else {
+        r.error("relative_to", "applies to peak_displacement only");
+        return std::nullopt;
+      }
+    }
     if (!body || !direction || !analysis) return std::nullopt;
+    s.relative_to = relative_to.value_or(-1);
     s.analysis = *analysis;
     s.body = *body;
     s.point = point.value_or(model->bodies[*body].position);

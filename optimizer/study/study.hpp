@@ -81,6 +81,8 @@ struct ResponseSpec {
   Vec3 point = Vec3::Zero();       // global point in the initial configuration [m]
   bool point_given = false;        // false: the body's position (the point follows the body)
   Vec3 direction = Vec3::UnitX();  // unit vector, global (the axis of a rotation)
+  // peak_displacement: the body whose frame the displacement is seen in (-1: the global frame)
+  int relative_to = -1;
   ElementEnd element;              // element_force
   int component = 0;               // element_force: 0..5 = fx, fy, fz, mx, my, mz
   int joint = 0;                   // joint_gap: joint index

@@ -278,7 +278,7 @@ TEST_F(BadInput, WrongEnumValues) {
       {"/analyses/0/integrator/method", "rk4", "\"bdf\""},
       {"/analyses/0/integrator/about", "sideways", "(expected one of \"static\", \"initial\")"},
       {"/scene/loads/0/type", "moment", "(expected one of \"force\", \"torque\")"},
-      {"/scene/loads/0/time/type", "sine", "\"ramp\", \"harmonic\", \"table\""},
+      {"/scene/loads/0/time/type", "sine", "\"ramp\", \"smooth_ramp\", \"harmonic\", \"table\""},
       {"/scene/sections/sq10/shape", "square", "\"rectangle\", \"circle\""},
       {"/analyses/0/type", "transiant", "\"transient\""},
       {"/responses/tip_peak/quantity", "peak", "\"peak_displacement\""},
@@ -367,6 +367,57 @@ TEST_F(BadInput, StaticControl) {
                            at + "max_steps:", ">= 1"));
   const Result ok = static_study(
       {{"type", "static"}, {"control", "arc_length"}, {"arc_length", 0.01}, {"max_steps", 50}});
+  EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
+}
+
+// A driven body's "motion": at least one velocity, each a vector, its time functions valid; no
+// "fixed", no initial velocities and no loads beside it. peak_displacement's relative_to names a
+// body, and only peak_displacement takes it.
+TEST_F(BadInput, PrescribedMotion) {
+  const auto with_hub = [&](const Json& motion) {
+    Json study = base();
+    study["scene"]["bodies"].push_back(
+        {{"name", "hub"}, {"position", {0, 0, 1}}, {"motion", motion}});
+    return study;
+  };
+  const std::string at = "bad.json:/scene/bodies/2/";
+  EXPECT_TRUE(HasOnlyError(check(with_hub(Json::object())),
+                           at + "motion:", "a motion needs \"velocity\" or \"angular_velocity\""));
+  EXPECT_TRUE(HasOnlyError(check(with_hub({{"velocity", "fast"}})),
+                           at + "motion/velocity:", "got a string"));
+  EXPECT_TRUE(HasOnlyError(
+      check(
+          with_hub({{"angular_velocity", {0, 0, 1}},
+                    {"angular_velocity_time", {{"type", "smooth_ramp"}, {"from", 1}, {"to", 0}}}})),
+      at + "motion/angular_velocity_time/to:", "must be greater than \"from\""));
+  EXPECT_TRUE(HasOnlyError(check(with_hub({{"angular_velocity", {0, 0, 1}}, {"spin", 1}})),
+                           at + "motion/spin:", "unknown key \"spin\""));
+  const Json spin = {{"angular_velocity", {0, 0, 1}}};
+  Json study = with_hub(spin);
+  study["scene"]["bodies"][2]["fixed"] = true;
+  EXPECT_TRUE(HasOnlyError(check(study), at + "fixed:", "driven, not fixed"));
+  study = with_hub(spin);
+  study["scene"]["bodies"][2]["velocity"] = {1, 0, 0};
+  EXPECT_TRUE(HasOnlyError(check(study), at + "velocity:", "its \"motion\"'s"));
+  study = with_hub(spin);
+  study["scene"]["loads"][0]["body"] = "hub";
+  EXPECT_TRUE(HasOnlyError(
+      check(study), "bad.json:/scene/loads/0/body:", "body \"hub\" is driven by its \"motion\""));
+  study = with_hub(spin);
+  study["responses"]["tip_peak"]["relative_to"] = "nobody";
+  EXPECT_TRUE(HasOnlyError(check(study),
+                           "bad.json:/responses/tip_peak/relative_to:", "unknown body \"nobody\""));
+  study = with_hub(spin);
+  study["analyses"].push_back({{"type", "static"}});
+  study["responses"]["sag"] = {{"quantity", "displacement"},
+                               {"body", "tip"},
+                               {"direction", {0, 1, 0}},
+                               {"relative_to", "hub"}};
+  EXPECT_TRUE(HasOnlyError(
+      check(study), "bad.json:/responses/sag/relative_to:", "applies to peak_displacement only"));
+  study = with_hub(spin);
+  study["responses"]["tip_peak"]["relative_to"] = "hub";
+  const Result ok = check(study);
   EXPECT_TRUE(ok.exited && ok.status == 0) << ok.how << ": " << ok.err;
 }
 

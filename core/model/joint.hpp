@@ -15,13 +15,25 @@
 
 namespace beamrail {
 
+// The gap p2 - p1 of the joint points (0 initially): the difference of their displacements, each
+// the centre's plus the lever's turn A r - A0 r. Taken from positions instead, the gap of a joint
+// 170 m from the origin carried the rounding of its coordinates (2e-14 m), which the penalty
+// stiffness turned into forces of 1e-3 N (a pinned frame in 160 segments, whose arc-length
+// path then stalled at that residual); a fixed body's lever turns by exactly nothing.
+template <class P, class T>
+Vec3T<T> joint_gap(const JointT<P>& j, const Pose<T>& b1, const Pose<T>& b2, const Vec3T<T>& lever1,
+                   const Vec3T<T>& lever2) {
+  return (b2.u + (lever2 - j.lever2.template cast<T>())) -
+         (b1.u + (lever1 - j.lever1.template cast<T>()));
+}
+
 // Adds the joint's wrenches on bodies 1 and 2 to w1 and w2 and returns its energy [J].
 // The joint's numbers are of a scalar P: double, or T itself (design sensitivities).
 template <class P, class T>
 T joint_wrenches(const JointT<P>& j, const Pose<T>& b1, const Pose<T>& b2, Vec6T<T>& w1,
                  Vec6T<T>& w2) {
   const Vec3T<T> lever1 = b1.A * j.r1.template cast<T>(), lever2 = b2.A * j.r2.template cast<T>();
-  const Vec3T<T> gap = j.centre_offset.template cast<T>() + b2.u + lever2 - b1.u - lever1;
+  const Vec3T<T> gap = joint_gap(j, b1, b2, lever1, lever2);
   const Vec3T<T> f2 = -j.k_force * gap;  // the force on body 2 at its joint point
   w2.template head<3>() += f2;
   w2.template tail<3>() += lever2.cross(f2);

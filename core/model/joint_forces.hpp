@@ -39,8 +39,8 @@ inline EndForces joint_end_forces(const Model& model, const Data& data, int inde
 // The gap p2 - p1 of the joint points, global [m].
 template <class S>
 Vec3T<S> joint_gap(const JointT<S>& j, const Pose<S>& b1, const Pose<S>& b2) {
-  return j.centre_offset.template cast<S>() + b2.u + b2.A * j.r2.template cast<S>() - b1.u -
-         b1.A * j.r1.template cast<S>();
+  return joint_gap(j, b1, b2, Vec3T<S>(b1.A * j.r1.template cast<S>()),
+                   Vec3T<S>(b2.A * j.r2.template cast<S>()));
 }
 
 // The angle [rad] between the axes a revolute joint keeps aligned, the angle of the relative

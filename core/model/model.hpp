@@ -116,8 +116,9 @@ struct JointT {
   Vec3T<S> r1 = Vec3T<S>::Zero(), r2 = Vec3T<S>::Zero();
   // The joint frame in each body's axes (equal in global axes initially); column 0 is the axis.
   Mat3T<S> frame1 = Mat3T<S>::Identity(), frame2 = Mat3T<S>::Identity();
-  Vec3T<S> centre_offset =
-      Vec3T<S>::Zero();          // c2 - c1 of the bodies' reference centres, global [m]
+  // The joint point from each centre in the initial configuration, global: A0 r (the gap is the
+  // two points' displacements apart, so that coordinates far from the centres round nothing).
+  Vec3T<S> lever1 = Vec3T<S>::Zero(), lever2 = Vec3T<S>::Zero();
   S relative_compliance = 1e-6;  // the penalty stiffness is the scene's scale over this
   S k_force = 0.0;               // [N/m]
   S k_moment = 0.0;              // [N m/rad]

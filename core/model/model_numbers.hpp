@@ -110,7 +110,8 @@ ModelT<T> zip_numbers(F&& f, const ModelT<S0>& first, const ModelT<S>&... others
     number(f, o.r2, j0.r2, others.joints[i].r2...);
     number(f, o.frame1, j0.frame1, others.joints[i].frame1...);
     number(f, o.frame2, j0.frame2, others.joints[i].frame2...);
-    number(f, o.centre_offset, j0.centre_offset, others.joints[i].centre_offset...);
+    number(f, o.lever1, j0.lever1, others.joints[i].lever1...);
+    number(f, o.lever2, j0.lever2, others.joints[i].lever2...);
     number(f, o.relative_compliance, j0.relative_compliance,
            others.joints[i].relative_compliance...);
     number(f, o.k_force, j0.k_force, others.joints[i].k_force...);

@@ -308,7 +308,8 @@ void build_joints(const SceneSpecsT<S>& specs, const std::vector<ElementSpecT<S>
     frame.col(2) = s.axis.cross(frame.col(1));
     j.frame1 = a1.transpose() * frame;
     j.frame2 = a2.transpose() * frame;
-    j.centre_offset = b2.position - b1.position;
+    j.lever1 = s.point - b1.position;
+    j.lever2 = s.point - b2.position;
     j.relative_compliance = s.relative_compliance;
     model.joints.push_back(j);
   }

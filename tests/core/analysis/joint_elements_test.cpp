@@ -15,6 +15,7 @@
 
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/static_analysis.hpp"
+#include "core/model/forces.hpp"
 #include "tests/support/scene_builder.hpp"
 
 namespace beamrail {
@@ -290,6 +291,40 @@ TEST(JointElements, AHangingRodOnARevoluteJointSwingsAsAMechanismAboveItsPenalty
     EXPECT_GT(elastic[i], 1e5 * swing_exact);
   }
   EXPECT_TRUE(has_warning(r.warnings, "5 elastic mode(s) deform joints and no beam or rail"));
+}
+
+// --- Rounding far from the origin ---------------------------------------------------------------
+
+// A joint's gap is the difference of its two points' displacements, not of their positions: a
+// joint between the ground and a body 100 .. 1,000 m from the origin carries exactly nothing at
+// rest, and a body moved by 1 nm is pulled back by k_f times 1 nm to rounding (taken from
+// positions, the gap carried their rounding, 1e-14 m, which made k_f 1e-14 m forces of noise: 1e-5
+// of this one; a pinned frame of 160 segments stalled on it, tests/core/analysis/lee_frame_test).
+TEST(JointElements, AJointFarFromTheOriginHoldsExactlyNothingAtRest) {
+  const double du = 1e-9;
+  double worst_rest = 0.0, worst_pull = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    const double far = 100.0 + 47.3 * k;
+    const Vec3 centre(far, 0.7 * far + 0.123, -0.31 * far), point = centre + Vec3(0.3, -0.11, 0.07);
+    Scene s;
+    s.material("steel", kE, kG, kDensity).square("sq", kSide);
+    s.body("b", 1.0, Vec3(1e-3, 1e-3, 1e-3), centre);
+    s.j["joints"] = Json::array({joint("pin", "spherical", "ground", "b", point)});
+    const Model model = s.model();
+    Data data(model);
+    const int b = body_index(model, "b");
+    compute_wrenches(model, data, 0.0);
+    worst_rest = std::max(worst_rest, data.wrench[b].norm());
+    data.pose[b].u = Vec3(du, -du, 0.5 * du);
+    compute_wrenches(model, data, 0.0);
+    const Vec3 expected = -model.joints[0].k_force * data.pose[b].u;
+    worst_pull =
+        std::max(worst_pull, (data.wrench[b].head<3>() - expected).norm() / expected.norm());
+  }
+  std::printf("joints 100 .. 1,000 m away: force at rest %.1e N; pull of a 1 nm move off by %.1e\n",
+              worst_rest, worst_pull);
+  EXPECT_EQ(worst_rest, 0.0);
+  EXPECT_LT(worst_pull, 1e-14);
 }
 
 }  // namespace

@@ -511,6 +511,42 @@ TEST(FollowerLoads, AnEndMomentBendsTheCantileverIntoACircle) {
   EXPECT_LT((extrapolated - exact).norm(), 1e-5);
 }
 
+// The full roll-up: M L / EI = 2 pi bends the cantilever into a whole circle, its tip back at the
+// clamp and turned by a full turn, for a moment of fixed direction and a follower moment alike.
+// Every segmented beam closes the circle exactly (its chords form a regular polygon), so the
+// tip's distance from the clamp is rounding; the tip body's rotation, followed continuously
+// through pi, is 2 pi. With automatic load steps (128 segments once stopped with "the loads push
+// along a direction without stiffness").
+TEST(FollowerLoads, AFullRollUpClosesTheCircle) {
+  for (int n : {16, 128})
+    for (bool follows : {true, false}) {
+      Scene s;
+      s.material("steel", kE, kG, kDensity);
+      s.custom("strip", 1e-2, 1e-8, 100 * kIy, kIy);
+      s.j["bodies"].push_back({{"name", "tip"}, {"position", vec(1, 0, 0)}});
+      s.beam("beam", "ground", "tip", Vec3::Zero(), Vec3(1, 0, 0), "steel", "strip");
+      s.last_beam()["segments"] = n;
+      s.j["loads"].push_back({{"type", "torque"},
+                              {"body", "tip"},
+                              {"value", vec(0, 0, 2 * kPi * kEIy)},
+                              {"follows", follows}});
+      const Model model = s.model();
+      Data data(model);
+      const StaticResult result = solve_static(model, StaticOptions{}, data);
+      ASSERT_TRUE(result.ok) << n << ": " << result.message;
+      const int tip = body_index(model, "tip");
+      const Vec3 tip_point = centre(model, data, tip) +
+                             data.pose[tip].A * (Vec3(1, 0, 0) - model.bodies[tip].position);
+      std::printf(
+          "roll-up, %3d segments, %s: tip %.1e m from the clamp, turned %.12f rad, %d load "
+          "steps\n",
+          n, follows ? "follower" : "fixed direction", tip_point.norm(), data.rotation[tip](2),
+          result.load_steps);
+      EXPECT_LT(tip_point.norm(), 1e-9);
+      EXPECT_NEAR(data.rotation[tip](2), 2 * kPi, 1e-9);
+    }
+}
+
 // The inextensible elastica under a tip force P that stays perpendicular to the tip: with the
 // slope theta(s), EI theta'' = Fx sin theta - Fy cos theta, F = P (-sin theta_L, cos theta_L),
 // theta(0) = 0, theta'(L) = 0. Shooting on theta_L (bisection), RK4 from the tip back to the

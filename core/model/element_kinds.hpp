@@ -9,11 +9,11 @@
 // over its own contiguous array as a hand-written loop would, without virtual calls.
 //
 // Adding a kind: its element struct and container in ModelT (model.hpp), its kernel in a file of
-// its own, a traits struct here and its name in ElementKinds (docs/model.md "Adding an element
-// kind").
+// its own, a traits struct here and its name in ElementKinds, its numbers in model_numbers.hpp,
+// its JSON in the scene reader, a sampler in tests/core/model/element_kinds_test.cpp
+// (docs/model.md "Adding an element kind").
 #pragma once
 
-#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/analysis/modal_integrator.hpp"
+#include "core/model/element_kinds.hpp"
 
 namespace beamrail {
 namespace {
@@ -30,8 +31,9 @@ SolverStats sum(const SolverStats& a, const SolverStats& b) {
 // The largest stiffness-proportional damping of the scene's elements [s].
 double largest_damping(const Model& model) {
   double beta = 0.0;
-  for (const Beam& b : model.beams) beta = std::max(beta, b.damping);
-  for (const Rail& r : model.rails) beta = std::max(beta, r.damping);
+  for_each_element(model, [&beta](auto kind, const auto& e, int) {
+    beta = std::max(beta, decltype(kind)::damping(e));
+  });
   return beta;
 }
 

@@ -1,9 +1,7 @@
 #include "core/model/forces.hpp"
 
-#include "core/model/beam.hpp"
+#include "core/model/element_kinds.hpp"
 #include "core/model/element_tangent.hpp"
-#include "core/model/joint.hpp"
-#include "core/model/rail.hpp"
 #include "core/model/wrench_assembly.hpp"
 
 namespace beamrail {
@@ -72,67 +70,30 @@ void compute_tangent(const Model& model, Data& data, double t, bool with_velocit
 
   add_load_stiffness(model, data, t, load_factor);
 
-  // The closed-form Jacobian for undamped elements, and for every element when velocities do not
-  // matter (static and modal analyses linearize at rest, where damping forces vanish); forward
-  // AD through the whole kernel (positions and velocities) for damped elements in motion.
-  for (size_t n = 0; n < model.beams.size(); ++n) {
-    const Beam& e = model.beams[n];
-    const Pose<double>& p1 = data.pose[e.ends.body1];
-    const Pose<double>& p2 = data.pose[e.ends.body2];
-    const auto& blocks = model.pattern.beam_blocks[n];
-    if (e.damping == 0.0 || !with_velocity) {
-      scatter(blocks,
-              configuration_jacobian(element_frames(e.ends, p1, p2, rotation_measure(e)),
-                                     e.formulation, rotation_measure(e),
-                                     [&e](const Vec6T<Ad6>& s) { return beam_law(e, s); }),
-              data.stiffness);
-      continue;
-    }
-    const auto kernel = [&e](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
-                             Vec6T<Ad12>& w2) { beam_wrenches(e, b1, b2, w1, w2); };
-    scatter(blocks, element_jacobian(seed_configuration(p1, 0), seed_configuration(p2, 6), kernel),
-            data.stiffness);
-    if (with_velocity)
-      scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
-              data.damping);
-  }
-  for (size_t n = 0; n < model.rails.size(); ++n) {
-    const Rail& e = model.rails[n];
-    const Pose<double>& p1 = data.pose[e.ends.body1];
-    const Pose<double>& p2 = data.pose[e.ends.body2];
-    const auto& blocks = model.pattern.rail_blocks[n];
-    if (e.damping == 0.0 || !with_velocity) {
-      scatter(blocks,
-              configuration_jacobian(element_frames(e.ends, p1, p2, rotation_measure(e)),
-                                     e.formulation, rotation_measure(e),
-                                     [&e](const Vec6T<Ad6>& s) {
-                                       bool floored = false;
-                                       return rail_law(e, s, &floored);
-                                     }),
-              data.stiffness);
-      continue;
+  // The kind's configuration tangent for undamped elements (the closed form of beams and rails),
+  // and for every element when velocities do not matter (static and modal analyses linearize at
+  // rest, where damping forces vanish); forward AD through the whole kernel (positions and
+  // velocities) for damped elements in motion.
+  int ordinal = 0;
+  for_each_element(model, [&](auto kind, const auto& e, int) {
+    using Kind = decltype(kind);
+    const Pose<double>& p1 = data.pose[Kind::body1(e)];
+    const Pose<double>& p2 = data.pose[Kind::body2(e)];
+    const std::array<int, 4>& blocks = model.pattern.element_blocks[ordinal++];
+    if (Kind::damping(e) == 0.0 || !with_velocity) {
+      scatter(blocks, Kind::configuration_jacobian(e, p1, p2), data.stiffness);
+      return;
     }
     const auto kernel = [&e](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
                              Vec6T<Ad12>& w2) {
       bool floored = false;
-      rail_wrenches(e, b1, b2, w1, w2, &floored);
+      Kind::wrenches(e, b1, b2, w1, w2, &floored, nullptr);
     };
     scatter(blocks, element_jacobian(seed_configuration(p1, 0), seed_configuration(p2, 6), kernel),
             data.stiffness);
-    if (with_velocity)
-      scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
-              data.damping);
-  }
-  // Joints: forward AD through the whole kernel (they have no velocity terms).
-  for (size_t n = 0; n < model.joints.size(); ++n) {
-    const Joint& j = model.joints[n];
-    const auto kernel = [&j](const Pose<Ad12>& b1, const Pose<Ad12>& b2, Vec6T<Ad12>& w1,
-                             Vec6T<Ad12>& w2) { joint_wrenches(j, b1, b2, w1, w2); };
-    scatter(model.pattern.joint_blocks[n],
-            element_jacobian(seed_configuration(data.pose[j.body1], 0),
-                             seed_configuration(data.pose[j.body2], 6), kernel),
-            data.stiffness);
-  }
+    scatter(blocks, element_jacobian(seed_velocity(p1, 0), seed_velocity(p2, 6), kernel),
+            data.damping);
+  });
   ++data.n_tangent_evaluations;
 }
 
@@ -153,11 +114,11 @@ double gravity_energy(const Model& model, const Data& data) {
 }
 
 bool has_damping(const Model& model) {
-  for (const Beam& e : model.beams)
-    if (e.damping > 0.0) return true;
-  for (const Rail& e : model.rails)
-    if (e.damping > 0.0) return true;
-  return false;
+  bool damped = false;
+  for_each_element(model, [&damped](auto kind, const auto& e, int) {
+    damped = damped || decltype(kind)::damping(e) > 0.0;
+  });
+  return damped;
 }
 
 }  // namespace beamrail

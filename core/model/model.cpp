@@ -4,6 +4,7 @@
 #include <map>
 #include <utility>
 
+#include "core/model/element_kinds.hpp"
 #include "core/model/hyper_dual.hpp"
 
 namespace beamrail {
@@ -45,14 +46,11 @@ void ModelT<S>::finalize() {
     index[{k, k}] = k;
     pattern.blocks.push_back({k, k});
   }
-  for (const BeamT<S>& e : beams)
-    pattern.beam_blocks.push_back(
-        couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
-  for (const RailT<S>& e : rails)
-    pattern.rail_blocks.push_back(
-        couple(bodies, index, pattern.blocks, e.ends.body1, e.ends.body2));
-  for (const JointT<S>& e : joints)
-    pattern.joint_blocks.push_back(couple(bodies, index, pattern.blocks, e.body1, e.body2));
+  for_each_element(*this, [&](auto kind, const auto& e, int) {
+    using Kind = decltype(kind);
+    pattern.element_blocks.push_back(
+        couple(bodies, index, pattern.blocks, Kind::body1(e), Kind::body2(e)));
+  });
   pattern.transposed.resize(pattern.blocks.size());
   for (size_t b = 0; b < pattern.blocks.size(); ++b)
     pattern.transposed[b] = index.at({pattern.blocks[b].col, pattern.blocks[b].row});
@@ -63,8 +61,8 @@ template void ModelT<HyperDual>::finalize();
 
 double characteristic_length(const Model& model) {
   double l = 0.0;
-  for (const Beam& e : model.beams) l = std::max(l, e.ends.length);
-  for (const Rail& e : model.rails) l = std::max(l, e.ends.length);
+  for_each_element(
+      model, [&l](auto kind, const auto& e, int) { l = std::max(l, decltype(kind)::length(e)); });
   return l > 0.0 ? l : 1.0;
 }
 
@@ -75,9 +73,10 @@ bool held_by_beams(const Model& model) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
-  for (const Beam& e : model.beams) parent[root(e.ends.body1)] = root(e.ends.body2);
-  for (const Joint& j : model.joints)
-    if (j.type == JointType::kFixed) parent[root(j.body1)] = root(j.body2);
+  for_each_element(model, [&](auto kind, const auto& e, int) {
+    using Kind = decltype(kind);
+    if (Kind::holds_all_six(e)) parent[root(Kind::body1(e))] = root(Kind::body2(e));
+  });
   std::vector<char> grounded(model.bodies.size(), 0);
   for (size_t i = 0; i < model.bodies.size(); ++i)
     if (model.bodies[i].fixed) grounded[root(static_cast<int>(i))] = 1;

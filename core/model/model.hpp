@@ -143,17 +143,23 @@ struct LoadT {
 };
 using Load = LoadT<double>;
 
+// One element of a model: the position of its kind in ElementKinds (core/model/element_kinds.hpp)
+// and its index in that kind's array.
+struct ElementRef {
+  int kind = 0;
+  int index = 0;
+};
+
 // Couplings between free bodies: the non-zero 6 x 6 blocks of tangent matrices, computed once.
 struct BlockPattern {
   struct Block {
     int row = 0, col = 0;  // free-body indices
   };
   std::vector<Block> blocks;  // diagonal blocks first (block k = free body k)
-  // Per element, the block index of (end a, end b) for a, b in {1, 2}, or -1 when either end is
-  // a fixed body: [0] = (1,1), [1] = (1,2), [2] = (2,1), [3] = (2,2).
-  std::vector<std::array<int, 4>> beam_blocks;
-  std::vector<std::array<int, 4>> rail_blocks;
-  std::vector<std::array<int, 4>> joint_blocks;
+  // Per element, in the order of for_each_element (core/model/element_kinds.hpp: the beams, the
+  // rails, the joints), the block index of (end a, end b) for a, b in {1, 2}, or -1 when either
+  // end is a fixed body: [0] = (1,1), [1] = (1,2), [2] = (2,1), [3] = (2,2).
+  std::vector<std::array<int, 4>> element_blocks;
   std::vector<int> transposed;  // per block, the index of the block (col, row)
 };
 
@@ -201,21 +207,11 @@ using DualModel = ModelT<HyperDual>;
 // structure).
 template <class S, class Keep>
 ModelT<S> with_loads(const ModelT<S>& model, Keep&& keep, bool gravity) {
-  ModelT<S> out;
-  out.bodies = model.bodies;
-  out.beams = model.beams;
-  out.rails = model.rails;
-  out.joints = model.joints;
+  ModelT<S> out = model;
+  out.loads.clear();
   for (const LoadT<S>& load : model.loads)
     if (keep(load)) out.loads.push_back(load);
-  out.gravity = gravity ? model.gravity : Vec3T<S>(Vec3T<S>::Zero());
-  out.load_cases = model.load_cases;
-  out.segment_choices = model.segment_choices;
-  out.free_bodies = model.free_bodies;
-  out.driven_bodies = model.driven_bodies;
-  out.n_states = model.n_states;
-  out.n_dofs = model.n_dofs;
-  out.pattern = model.pattern;
+  if (!gravity) out.gravity = Vec3T<S>::Zero();
   return out;
 }
 

@@ -5,10 +5,8 @@
 
 #include <vector>
 
-#include "core/model/beam.hpp"
-#include "core/model/joint.hpp"
+#include "core/model/element_kinds.hpp"
 #include "core/model/model.hpp"
-#include "core/model/rail.hpp"
 
 namespace beamrail {
 
@@ -40,27 +38,21 @@ void add_load_wrenches(const ModelT<S>& model, const std::vector<Pose<S>>& pose,
   }
 }
 
-// Adds the wrenches of every beam, rail and joint and returns their strain energy. For doubles,
-// sets rail_floored[r] (when given) per rail and *out_of_range when an element left its law's
-// range.
+// Adds the wrenches of every element and returns their strain energy. For doubles, sets
+// rail_floored[r] (when given) per rail and *out_of_range when an element left its law's range.
 template <class S>
 S add_element_wrenches(const ModelT<S>& model, const std::vector<Pose<S>>& pose,
                        std::vector<Vec6T<S>>& wrench, std::vector<char>* rail_floored = nullptr,
                        bool* out_of_range = nullptr) {
   S energy = 0.0;
-  for (const BeamT<S>& e : model.beams) {
-    const int i1 = e.ends.body1, i2 = e.ends.body2;
-    energy += beam_wrenches(e, pose[i1], pose[i2], wrench[i1], wrench[i2], out_of_range);
-  }
-  for (size_t r = 0; r < model.rails.size(); ++r) {
-    const RailT<S>& e = model.rails[r];
-    const int i1 = e.ends.body1, i2 = e.ends.body2;
+  for_each_element(model, [&](auto kind, const auto& e, int n) {
+    using Kind = decltype(kind);
+    const int i1 = Kind::body1(e), i2 = Kind::body2(e);
     bool floored = false;
-    energy += rail_wrenches(e, pose[i1], pose[i2], wrench[i1], wrench[i2], &floored, out_of_range);
-    if (rail_floored) (*rail_floored)[r] = floored;
-  }
-  for (const JointT<S>& j : model.joints)
-    energy += joint_wrenches(j, pose[j.body1], pose[j.body2], wrench[j.body1], wrench[j.body2]);
+    energy += Kind::wrenches(e, pose[i1], pose[i2], wrench[i1], wrench[i2], &floored, out_of_range);
+    if constexpr (Kind::kFloors)
+      if (rail_floored) (*rail_floored)[n] = floored;
+  });
   return energy;
 }
 

@@ -7,6 +7,7 @@
 #include <new>
 
 #include "core/analysis/stop_request.hpp"
+#include "core/model/element_kinds.hpp"
 #include "optimizer/batch/mpi_job.hpp"
 #include "optimizer/batch/run_settings.hpp"
 #include "optimizer/cli/batch_commands.hpp"
@@ -136,11 +137,14 @@ int check(const RunArguments& args) {
   }
   for (const std::string& w : study->input_warnings) std::cerr << "warning: " << w << "\n";
   const Model& m = study->model;
-  std::cout << args.study << ": ok (" << m.bodies.size() - 1 << " bodies, " << m.beams.size()
-            << " beams, " << m.rails.size() << " rails, "
-            << (m.joints.empty() ? "" : std::to_string(m.joints.size()) + " joints, ") << m.n_states
-            << " states, " << study->analyses.size() << " analyses, " << study->responses.size()
-            << " responses)\n";
+  std::cout << args.study << ": ok (" << m.bodies.size() - 1 << " bodies, ";
+  for_each_element_kind([&](auto kind) {
+    using Kind = decltype(kind);
+    const size_t n = Kind::elements(m).size();
+    if (n > 0 || Kind::kCountedWhenNone) std::cout << n << " " << Kind::kName << "s, ";
+  });
+  std::cout << m.n_states << " states, " << study->analyses.size() << " analyses, "
+            << study->responses.size() << " responses)\n";
   for (const SegmentChoice& c : m.segment_choices) {
     char line[200];
     std::snprintf(line, sizeof line,

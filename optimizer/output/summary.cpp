@@ -1,7 +1,9 @@
 #include "optimizer/output/summary.hpp"
 
 #include <cmath>
+#include <string>
 
+#include "core/model/element_kinds.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
 #include "optimizer/run/status.hpp"
@@ -37,12 +39,14 @@ nlohmann::json model_summary(const Model& model) {
   nlohmann::json out{{"bodies", static_cast<int>(model.bodies.size()) - 1 - generated},
                      {"generated_bodies", generated},
                      {"free_bodies", model.n_free()},
-                     {"beams", model.beams.size()},
-                     {"rails", model.rails.size()},
                      {"loads", model.loads.size()},
                      {"states", model.n_states},
                      {"degrees_of_freedom", model.n_dofs}};
-  if (!model.joints.empty()) out["joints"] = model.joints.size();
+  for_each_element_kind([&](auto kind) {
+    using Kind = decltype(kind);
+    const size_t n = Kind::elements(model).size();
+    if (n > 0 || Kind::kCountedWhenNone) out[std::string(Kind::kName) + "s"] = n;
+  });
   if (!model.segment_choices.empty()) {
     nlohmann::json chosen = nlohmann::json::array();
     for (const SegmentChoice& c : model.segment_choices)

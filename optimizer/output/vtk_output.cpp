@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "core/model/element_forces.hpp"
+#include "core/model/element_kinds.hpp"
 #include "core/model/element_kinematics.hpp"
 #include "core/model/generalized.hpp"
 #include "core/model/joint_forces.hpp"
@@ -64,16 +65,12 @@ class SceneDrawing {
     const auto extend = [&](const Vec3& p) { lo = lo.cwiseMin(p), hi = hi.cwiseMax(p); };
     const Data initial(model);
     for (size_t i = 1; i < model.bodies.size(); ++i) extend(model.bodies[i].position);
-    const auto ends = [&](const ElementEnds& e) {
-      extend(centre(model, initial, e.body1) + initial.pose[e.body1].A * e.r1);
-      extend(centre(model, initial, e.body2) + initial.pose[e.body2].A * e.r2);
-    };
-    for (const Beam& b : model.beams) ends(b.ends);
-    for (const Rail& r : model.rails) ends(r.ends);
-    for (const Joint& j : model.joints) {
-      extend(centre(model, initial, j.body1) + initial.pose[j.body1].A * j.r1);
-      extend(centre(model, initial, j.body2) + initial.pose[j.body2].A * j.r2);
-    }
+    for_each_element(model, [&](auto kind, const auto& e, int) {
+      using Kind = decltype(kind);
+      const int i1 = Kind::body1(e), i2 = Kind::body2(e);
+      extend(centre(model, initial, i1) + initial.pose[i1].A * Kind::point1(e));
+      extend(centre(model, initial, i2) + initial.pose[i2].A * Kind::point2(e));
+    });
     size_ = (hi - lo).allFinite() ? (hi - lo).norm() : 0.0;
     if (!(size_ > 0.0)) size_ = characteristic_length(model);
 
@@ -86,16 +83,11 @@ class SceneDrawing {
       d.body = static_cast<int>(i);
       d.corners = box(b);
       if (!b.generated) {
-        const auto attach = [&](const ElementEnds& e) {
-          if (e.body1 == d.body) d.levers.push_back(e.r1);
-          if (e.body2 == d.body) d.levers.push_back(e.r2);
-        };
-        for (const Beam& e : model.beams) attach(e.ends);
-        for (const Rail& e : model.rails) attach(e.ends);
-        for (const Joint& j : model.joints) {
-          if (j.body1 == d.body) d.levers.push_back(j.r1);
-          if (j.body2 == d.body) d.levers.push_back(j.r2);
-        }
+        for_each_element(model, [&](auto kind, const auto& e, int) {
+          using Kind = decltype(kind);
+          if (Kind::body1(e) == d.body) d.levers.push_back(Kind::point1(e));
+          if (Kind::body2(e) == d.body) d.levers.push_back(Kind::point2(e));
+        });
         for (const Load& l : model.loads)
           if (l.kind == LoadKind::kForce && l.body == d.body) d.levers.push_back(l.offset);
       }
@@ -131,6 +123,7 @@ class SceneDrawing {
       Curve c;
       c.rail = rail;
       c.index = index;
+      c.element = {rail ? kElementKindIndex<RailKind> : kElementKindIndex<BeamKind>, index};
       c.ends = &e;
       for (int k = 0; k < n; ++k) c.s.push_back(static_cast<double>(k) / (n - 1));
       element_index.push_back(index);
@@ -156,6 +149,7 @@ class SceneDrawing {
       Curve c;
       c.joint = true;
       c.index = static_cast<int>(i);
+      c.element = {kElementKindIndex<JointKind>, c.index};
       c.s = {0.0, 1.0};
       element_index.push_back(c.index);
       element_kind.push_back(0);
@@ -262,21 +256,14 @@ class SceneDrawing {
               std::vector<double>& gaps) const {
     out.resize(curves_.size());
     stress.resize(curves_.size());
-    gaps.assign(curves_.size(), kNaN);
-    for (size_t k = 0; k < curves_.size(); ++k) {
-      const Curve& c = curves_[k];
-      if (c.joint) {
-        const Joint& j = model_.joints[c.index];
-        out[k] = joint_end_forces(model_, data, c.index);
-        stress[k] = kNaN;
-        gaps[k] = joint_gap(j, data.pose[j.body1], data.pose[j.body2]).norm();
-        continue;
-      }
-      out[k] =
-          c.rail ? rail_end_forces(model_, data, c.index) : beam_end_forces(model_, data, c.index);
-      stress[k] = end_stress(c.rail ? model_.rails[c.index].section : model_.beams[c.index].section,
-                             out[k]);
-    }
+    gaps.resize(curves_.size());
+    for (size_t k = 0; k < curves_.size(); ++k)
+      visit_element(model_, curves_[k].element, [&](auto kind, const auto& e, int index) {
+        using Kind = decltype(kind);
+        out[k] = Kind::end_forces(model_, data.pose, index);
+        stress[k] = Kind::stress(e, out[k]);
+        gaps[k] = Kind::gap(e, data.pose[Kind::body1(e)], data.pose[Kind::body2(e)]);
+      });
   }
 
   const Geometry& initial() const { return initial_; }
@@ -295,6 +282,7 @@ class SceneDrawing {
     std::vector<Vec3> levers;     // attachment points, body axes, from the centre
   };
   struct Curve {
+    ElementRef element;
     bool rail = false;
     bool joint = false;                                  // index is a joint's; ends is null
     RotationMeasure measure = RotationMeasure::kAngles;  // the element's (slopes from phi)

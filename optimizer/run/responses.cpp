@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/model/element_forces.hpp"
+#include "core/model/element_kinds.hpp"
 #include "core/model/joint_forces.hpp"
 #include "core/model/rotation.hpp"
 
@@ -60,9 +61,10 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
         break;
       }
       case ResponseSpec::Quantity::kElementForce: {
-        const EndForces f = r.element.joint  ? joint_end_forces(model, data, r.element.index)
-                            : r.element.rail ? rail_end_forces(model, data, r.element.index)
-                                             : beam_end_forces(model, data, r.element.index);
+        const EndForces f =
+            visit_element(model, r.element.ref, [&](auto kind, const auto&, int index) {
+              return decltype(kind)::end_forces(model, data.pose, index);
+            });
         values[k] = (r.element.end == 1 ? f.end1 : f.end2)(r.component);
         break;
       }
@@ -116,10 +118,10 @@ void static_response_derivatives(const Study& study, int analysis, const Model& 
         break;
       }
       case ResponseSpec::Quantity::kElementForce: {
-        const EndForcesT<H> f = r.element.joint ? joint_end_forces(direction, pose, r.element.index)
-                                : r.element.rail
-                                    ? rail_end_forces(direction, pose, r.element.index)
-                                    : beam_end_forces(direction, pose, r.element.index);
+        const EndForcesT<H> f =
+            visit_element(direction, r.element.ref, [&](auto kind, const auto&, int index) {
+              return decltype(kind)::end_forces(direction, pose, index);
+            });
         values[k] = (r.element.end == 1 ? f.end1 : f.end2)(r.component).b;
         break;
       }

@@ -8,18 +8,19 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/sensitivity.hpp"
 #include "core/model/data.hpp"
+#include "core/model/element_kinds.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
 
-// Total structural mass: declared body masses plus rho S l of every beam and rail with a density.
+// Total structural mass: declared body masses plus the elements' (rho S l of every beam and rail
+// with a density; joints have none).
 // On the model's scalar (double, or HyperDual for the design sensitivities).
 template <class S>
 S structural_mass(const ModelT<S>& model) {
   S m = 0.0;
   for (const BodyT<S>& b : model.bodies) m += b.declared_mass;
-  for (const BeamT<S>& e : model.beams) m += e.density * e.section.area * e.ends.length;
-  for (const RailT<S>& e : model.rails) m += e.density * e.section.area * e.ends.length;
+  for_each_element(model, [&m](auto kind, const auto& e, int) { m += decltype(kind)::mass(e); });
   return m;
 }
 

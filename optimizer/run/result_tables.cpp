@@ -1,6 +1,6 @@
 #include "optimizer/run/result_tables.hpp"
 
-#include "core/model/element_forces.hpp"
+#include "core/model/element_kinds.hpp"
 #include "core/model/joint_forces.hpp"
 #include "optimizer/run/number_text.hpp"
 
@@ -28,12 +28,9 @@ std::vector<ResultTable> static_tables(const std::string& prefix, const Model& m
       forces.rows.push_back(std::move(row));
     }
   };
-  for (size_t i = 0; i < model.beams.size(); ++i)
-    rows(model.beams[i].name, beam_end_forces(model, data, static_cast<int>(i)));
-  for (size_t i = 0; i < model.rails.size(); ++i)
-    rows(model.rails[i].name, rail_end_forces(model, data, static_cast<int>(i)));
-  for (size_t i = 0; i < model.joints.size(); ++i)
-    rows(model.joints[i].name, joint_end_forces(model, data, static_cast<int>(i)));
+  for_each_element(model, [&](auto kind, const auto& e, int index) {
+    rows(e.name, decltype(kind)::end_forces(model, data.pose, index));
+  });
   std::vector<ResultTable> out{std::move(displacements), std::move(forces)};
   if (model.joints.empty()) return out;
   ResultTable gaps{prefix + "joint_gaps.csv", {"joint", "gap", "gx", "gy", "gz", "angle"}, {}};

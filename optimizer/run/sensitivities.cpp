@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "core/analysis/sensitivity.hpp"
+#include "core/model/element_kinds.hpp"
 #include "optimizer/run/expressions.hpp"
 #include "optimizer/run/number_text.hpp"
 #include "optimizer/run/responses.hpp"
@@ -19,10 +20,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 template <class A, class B>
 bool same_topology(const ModelT<A>& a, const ModelT<B>& b) {
-  return a.n_dofs == b.n_dofs && a.bodies.size() == b.bodies.size() &&
-         a.beams.size() == b.beams.size() && a.rails.size() == b.rails.size() &&
-         a.joints.size() == b.joints.size() && a.loads.size() == b.loads.size() &&
-         a.free_bodies == b.free_bodies;
+  bool same = a.n_dofs == b.n_dofs && a.bodies.size() == b.bodies.size() &&
+              a.loads.size() == b.loads.size() && a.free_bodies == b.free_bodies;
+  for_each_element_kind([&](auto kind) {
+    same = same && decltype(kind)::elements(a).size() == decltype(kind)::elements(b).size();
+  });
+  return same;
 }
 
 // Whether the design direction moves a breakpoint of a load's time function (a step's time, a

@@ -3,6 +3,7 @@
 #include <iterator>
 
 #include "core/analysis/modal_analysis.hpp"
+#include "core/model/element_kinds.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
@@ -60,20 +61,8 @@ std::optional<Vec3> unit_vector(ObjectReader& r, const std::string& key) {
 std::optional<ElementEnd> element_named(ObjectReader& r, const Model* model, int end) {
   const auto name = r.string("element", true);
   if (!name || !model) return std::nullopt;
-  for (size_t i = 0; i < model->rails.size(); ++i)
-    if (model->rails[i].name == *name) return ElementEnd{true, static_cast<int>(i), end};
-  for (size_t i = 0; i < model->joints.size(); ++i)
-    if (model->joints[i].name == *name) return ElementEnd{false, static_cast<int>(i), end, true};
-  int found = -1;
-  for (size_t i = 0; i < model->beams.size(); ++i) {
-    const Beam& b = model->beams[i];
-    if (b.group != *name) continue;
-    // The segment that holds the requested end of the scene beam.
-    if (found < 0 || (end == 2 && b.segment > model->beams[found].segment))
-      found = static_cast<int>(i);
-    if (end == 1 && b.segment <= 1) found = static_cast<int>(i);
-  }
-  if (found >= 0) return ElementEnd{false, found, end};
+  if (const std::optional<ElementRef> found = find_element(*model, *name, end))
+    return ElementEnd{*found, end};
   r.error("element", "unknown element \"" + *name + "\"");
   return std::nullopt;
 }
@@ -316,12 +305,11 @@ std::optional<ResponseSpec> read_response(const std::string& name, const Json& v
     const auto analysis = analysis_for(r, study, AnalysisSpec::Type::kStatic, *q);
     const auto joint = r.string("joint", true);
     if (!joint || !analysis || !model) return std::nullopt;
-    for (size_t i = 0; i < model->joints.size(); ++i)
-      if (model->joints[i].name == *joint) {
-        s.analysis = *analysis;
-        s.joint = static_cast<int>(i);
-        return s;
-      }
+    if (const int index = index_named(model->joints, *joint); index >= 0) {
+      s.analysis = *analysis;
+      s.joint = index;
+      return s;
+    }
     r.error("joint", "unknown joint \"" + *joint + "\"");
     return std::nullopt;
   }

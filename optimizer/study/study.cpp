@@ -4,6 +4,7 @@
 #include <map>
 #include <set>
 
+#include "core/model/element_kinds.hpp"
 #include "core/scene/scene_loader.hpp"
 #include "optimizer/run/expressions.hpp"
 
@@ -196,19 +197,12 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
 namespace {
 
 bool same_structure(const Model& a, const Model& b) {
-  if (a.bodies.size() != b.bodies.size() || a.beams.size() != b.beams.size() ||
-      a.rails.size() != b.rails.size() || a.joints.size() != b.joints.size() ||
+  if (a.bodies.size() != b.bodies.size() || !same_elements(a, b) ||
       a.loads.size() != b.loads.size() || a.free_bodies != b.free_bodies ||
       a.load_cases != b.load_cases || (a.gravity.norm() > 0.0) != (b.gravity.norm() > 0.0))
     return false;
   for (size_t i = 0; i < a.bodies.size(); ++i)
     if (a.bodies[i].name != b.bodies[i].name) return false;
-  for (size_t i = 0; i < a.beams.size(); ++i)
-    if (a.beams[i].name != b.beams[i].name) return false;
-  for (size_t i = 0; i < a.rails.size(); ++i)
-    if (a.rails[i].name != b.rails[i].name) return false;
-  for (size_t i = 0; i < a.joints.size(); ++i)
-    if (a.joints[i].name != b.joints[i].name || a.joints[i].type != b.joints[i].type) return false;
   for (size_t i = 0; i < a.loads.size(); ++i)
     if (a.loads[i].body != b.loads[i].body || a.loads[i].kind != b.loads[i].kind ||
         a.loads[i].load_case != b.loads[i].load_case)

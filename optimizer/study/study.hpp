@@ -46,12 +46,11 @@ const char* type_name(AnalysisSpec::Type type);
 // named after its type, else "<name>.<table>".
 std::string table_file(const AnalysisSpec& analysis, const std::string& table);
 
-// Where an element's end forces are read: element kind and index, and which end (1 or 2).
+// Where an element's end forces are read: the element (a joint's forces are in the joint frame,
+// docs/model.md "Joints"), and which end (1 or 2).
 struct ElementEnd {
-  bool rail = false;
-  int index = 0;
+  ElementRef ref;
   int end = 1;
-  bool joint = false;  // index is a joint's (docs/model.md "Joints": forces in the joint frame)
 };
 
 struct ResponseSpec {

@@ -104,6 +104,7 @@ class AutoIntegrator : public Integrator {
     if (const std::string band = modal_band_choice(*modal); !band.empty()) reason += "; " + band;
     for (const std::string& w : modal->warnings) warnings.push_back(w);
     const bool about_initial = o.about == "initial" || !modal->warnings.empty();
+    band_hz = modal->band_hz;
     current_ = std::move(modal);
     modal_ = true;
     linear_solver = "modal";
@@ -157,6 +158,7 @@ class AutoIntegrator : public Integrator {
         continue;
       }
       next->restart(*t, y);
+      band_hz = std::max(band_hz, next->band_hz);
       current_ = std::move(next);
       record(*t, "modal",
              "body " + who + " turned " + number(turned) +

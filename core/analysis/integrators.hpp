@@ -28,6 +28,9 @@ class Integrator {
   std::string linear_solver = "none";
   long nnz = 0;                       // stored Jacobian entries (sparse)
   std::vector<std::string> warnings;  // for the run's result (set up at construction)
+  // The highest frequency a band-limited modal method integrated [Hz], given or chosen (auto: the
+  // highest of its modal phases); 0 when every mode was integrated or the method has no band.
+  double band_hz = 0.0;
   // The phases so far (auto switches methods and relinearizes; others have none) and their count.
   virtual std::vector<MethodPhase> phases(long* count) const {
     *count = 0;

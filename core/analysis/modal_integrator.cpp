@@ -115,6 +115,7 @@ class ModalExponential : public Integrator {
     }
     from_states(y);
     linear_solver = "modal";
+    band_hz = m_ < n_ ? band_hz_ : 0.0;
     stats_.jacobian_evaluations = 1;  // the tangent of the linearization
     return true;
   }

@@ -217,6 +217,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     result.t_reached = t;
     result.stats = integrator->stats();
     result.phases = integrator->phases(&result.phase_count);
+    result.max_frequency_hz = integrator->band_hz;
     for (const std::string& w : integrator->warnings)  // auto's arrive during the run
       if (std::find(result.warnings.begin(), result.warnings.end(), w) == result.warnings.end())
         result.warnings.push_back(w);

@@ -127,6 +127,9 @@ struct TransientResult {
   // were in all.
   std::vector<MethodPhase> phases;
   long phase_count = 0;
+  // The band a modal phase integrated [Hz] (Integrator::band_hz): given, or chosen for rtol; 0:
+  // every mode.
+  double max_frequency_hz = 0.0;
 };
 inline constexpr size_t kMaxRecordedPhases = 20;
 

@@ -332,7 +332,9 @@ class Runner {
     report.linear_solver = result.linear_solver;
     report.phases = result.phases;
     report.phase_count = result.phase_count;
-    report.max_frequency_hz = options.integrator.max_frequency_hz;
+    // The band integrated: chosen for rtol ("auto", or by auto on a large scene) or given.
+    report.max_frequency_hz = result.max_frequency_hz > 0.0 ? result.max_frequency_hz
+                                                            : options.integrator.max_frequency_hz;
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);

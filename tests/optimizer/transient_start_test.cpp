@@ -137,23 +137,36 @@ TEST_F(TransientStart, ARunStartingWithoutEnergyReportsTheAbsoluteChange) {
 
 // A study's transient without a method runs "auto" and says what it chose; "max_frequency_hz":
 // "output" is half the output rate (here 250 Hz: the first mode, 2.6 Hz, is integrated, the tip's
-// fast rotary mode is quasi-static), and the tip still overshoots to twice its static sag.
+// fast rotary mode is quasi-static), "auto" the band chosen for rtol (the two bending modes, the
+// rotary ones quasi-static), which summary.json reports as it reports a given one; and the tip
+// still overshoots to twice its static sag.
 TEST_F(TransientStart, TheDefaultMethodIsAutoAndTheBandCanFollowTheOutput) {
-  for (const bool band : {false, true}) {
+  for (const std::string band : {"", "output", "auto"}) {
     Json s = study("");
     s["analyses"][0]["integrator"] = {{"rtol", 1e-8}, {"atol", 1e-11}};
-    if (band) s["analyses"][0]["max_frequency_hz"] = "output";
-    const std::string name = band ? "band" : "auto";
+    if (!band.empty()) s["analyses"][0]["max_frequency_hz"] = band;
+    const std::string name = band.empty() ? "every_mode" : band;
     const Json summary = run_ok(s, name);
     const Json& a = summary["analyses"][0];
     EXPECT_EQ(a["integrator"], "auto");
     EXPECT_EQ(a["method"], "modal");
-    EXPECT_NE(a["method_reason"].get<std::string>().find("1 free body"), std::string::npos);
+    const std::string reason = a["method_reason"].get<std::string>();
+    EXPECT_NE(reason.find("1 free body"), std::string::npos);
     // The tip turns 0.11 rad: relinearized as it goes (small scene: every 0.02 rad).
     EXPECT_EQ(a["phase_count"].get<size_t>(), a["phases"].size());
     for (const Json& p : a["phases"]) EXPECT_EQ(p["method"], "modal") << p.dump();
-    if (band) {
+    if (band == "output") {
       EXPECT_DOUBLE_EQ(a["max_frequency_hz"].get<double>(), 0.5 / 0.002);
+    } else if (band == "auto") {
+      // The band the reason names, to all its digits; every phase chose one as low.
+      const size_t at = reason.find("band ");
+      ASSERT_NE(at, std::string::npos) << reason;
+      const double chosen = std::stod(reason.substr(at + 5));
+      std::printf("chosen band %.6f Hz: %s\n", chosen, reason.c_str());
+      EXPECT_GE(a["max_frequency_hz"].get<double>(), chosen);
+      EXPECT_LT(a["max_frequency_hz"].get<double>(), 1.01 * chosen);
+      EXPECT_GT(chosen, 2.5);  // the first bending mode (2.6 Hz) is integrated
+      EXPECT_LT(chosen, 250.0);
     } else {
       EXPECT_FALSE(a.contains("max_frequency_hz"));
     }

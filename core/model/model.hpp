@@ -28,8 +28,8 @@ struct BodyT {
   Vec4T<S> orientation = Vec4T<S>(1, 0, 0, 0);  // initial Euler parameters (body -> global)
   Vec3T<S> velocity = Vec3T<S>::Zero();  // initial velocity of the centre of mass, global [m/s]
   Vec3T<S> angular_velocity = Vec3T<S>::Zero();  // initial angular velocity, body axes [rad/s]
-  bool fixed = false;      // true also for a driven body: no analysis solves for its motion
-  bool driven = false;     // moved as `motion` prescribes (core/model/motion.hpp); fixed too
+  bool fixed = false;   // true also for a driven body: no analysis solves for its motion
+  bool driven = false;  // moved as `motion` prescribes (core/model/motion.hpp); fixed too
   PrescribedMotion motion;
   bool generated = false;  // interior body of a segmented beam
   S declared_mass = 0.0;   // the mass given in the scene, before segment masses
@@ -187,8 +187,8 @@ struct ModelT {
 
   std::vector<int> free_bodies;    // body index of each free body, in state order
   std::vector<int> driven_bodies;  // body index of each driven body
-  int n_states = 0;              // 13 per free body: c(3), q(4), v(3), w(3)
-  int n_dofs = 0;                // 6 per free body: dc(3), dtheta(3)
+  int n_states = 0;                // 13 per free body: c(3), q(4), v(3), w(3)
+  int n_dofs = 0;                  // 6 per free body: dc(3), dtheta(3)
   BlockPattern pattern;
 
   int n_free() const { return static_cast<int>(free_bodies.size()); }

@@ -82,10 +82,10 @@ struct ResponseSpec {
   Vec3 direction = Vec3::UnitX();  // unit vector, global (the axis of a rotation)
   // peak_displacement: the body whose frame the displacement is seen in (-1: the global frame)
   int relative_to = -1;
-  ElementEnd element;              // element_force
-  int component = 0;               // element_force: 0..5 = fx, fy, fz, mx, my, mz
-  int joint = 0;                   // joint_gap: joint index
-  std::vector<int> beams;          // max_stress: beam indices considered (all when empty)
+  ElementEnd element;      // element_force
+  int component = 0;       // element_force: 0..5 = fx, fy, fz, mx, my, mz
+  int joint = 0;           // joint_gap: joint index
+  std::vector<int> beams;  // max_stress: beam indices considered (all when empty)
   // mass: the bodies (indices) and elements (beam and rail indices) counted; all when `subset` is
   // false
   bool subset = false;

@@ -464,8 +464,8 @@ TEST(FollowerLoads, BecksColumnUnderADeadLoadBucklesAtEulersLoad) {
 // A cantilever along x (L = 1 m) in n segments, bending in the x-y plane about z (E Iz = 21 N m^2;
 // Iy = 100 Iz out of the plane, and an axial stiffness 10^8 times E Iz / L^2: a strain of 2e-8
 // under 2 EI / L^2, so the beam is as inextensible as the elastica it is compared with), a tip
-// body without mass of its own, one tip load of value `value` (follower or not). Returns the tip.
-Vec3 bent_tip(int n, const std::string& type, const Vec3& value, bool follows) {
+// body without mass of its own, one tip load of value `value` (follower or not).
+Model bent_cantilever(int n, const std::string& type, const Vec3& value, bool follows) {
   Scene s;
   s.material("steel", kE, kG, kDensity);
   s.custom("strip", 1e-2, 1e-8, 100 * kIy, kIy);
@@ -475,7 +475,12 @@ Vec3 bent_tip(int n, const std::string& type, const Vec3& value, bool follows) {
   s.j["loads"].push_back(
       {{"type", type}, {"body", "tip"}, {"value", vec(value(0), value(1), value(2))}});
   s.j["loads"].back()["follows"] = follows;
-  const Model model = s.model();
+  return s.model();
+}
+
+// The tip of bent_cantilever(...) at its static equilibrium.
+Vec3 bent_tip(int n, const std::string& type, const Vec3& value, bool follows) {
+  const Model model = bent_cantilever(n, type, value, follows);
   Data data(model);
   const StaticResult result = solve_static(model, StaticOptions{}, data);
   EXPECT_TRUE(result.ok) << result.message;
@@ -520,17 +525,7 @@ TEST(FollowerLoads, AnEndMomentBendsTheCantileverIntoACircle) {
 TEST(FollowerLoads, AFullRollUpClosesTheCircle) {
   for (int n : {16, 128})
     for (bool follows : {true, false}) {
-      Scene s;
-      s.material("steel", kE, kG, kDensity);
-      s.custom("strip", 1e-2, 1e-8, 100 * kIy, kIy);
-      s.j["bodies"].push_back({{"name", "tip"}, {"position", vec(1, 0, 0)}});
-      s.beam("beam", "ground", "tip", Vec3::Zero(), Vec3(1, 0, 0), "steel", "strip");
-      s.last_beam()["segments"] = n;
-      s.j["loads"].push_back({{"type", "torque"},
-                              {"body", "tip"},
-                              {"value", vec(0, 0, 2 * kPi * kEIy)},
-                              {"follows", follows}});
-      const Model model = s.model();
+      const Model model = bent_cantilever(n, "torque", Vec3(0, 0, 2 * kPi * kEIy), follows);
       Data data(model);
       const StaticResult result = solve_static(model, StaticOptions{}, data);
       ASSERT_TRUE(result.ok) << n << ": " << result.message;

@@ -12,6 +12,7 @@
 #include "core/analysis/exponential_step.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/modal_band.hpp"
+#include "core/analysis/modal_reference.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/model/dynamics.hpp"
 #include "core/model/forces.hpp"
@@ -40,13 +41,6 @@ void subtract_product(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, Eigen:
   work.resize(a.rows());
   multiply_vector(a, b.data(), work.data());
   out -= work;
-}
-
-// "1 rad" for messages.
-std::string rotation_limit_text() {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g rad", kModalIntegratorMaxRotation);
-  return text;
 }
 
 enum Flag {
@@ -85,7 +79,7 @@ class ModalExponential : public Integrator {
     ydot13_.resize(model.n_states);
     const double* y = N_VGetArrayPointer(y0);
     std::vector<double> reference(y, y + model.n_states);
-    if (!choose_reference(model, reference, error)) return false;
+    if (!modal_reference(model, options_, *context_, reference, warnings, error)) return false;
     // The linearization: mass and symmetric tangent stiffness at the reference, at rest.
     Data& data = c.data;
     set_state(model, data, reference.data());
@@ -202,63 +196,6 @@ class ModalExponential : public Integrator {
   bool fail(std::string* error, const std::string& what) {
     *error = what;
     return false;
-  }
-
-  // The state linearized about (options_.about), written over `reference` (which holds the
-  // initial state): the static equilibrium under the loads at t = 0, at rest, or the initial
-  // state. False (with *error) when "static" was asked for and no equilibrium was found.
-  bool choose_reference(const Model& model, std::vector<double>& reference, std::string* error) {
-    if (options_.about == "initial") return true;
-    if (!options_.about.empty() && options_.about != "static")
-      return fail(error, "the modal integrator: unknown \"about\": \"" + options_.about +
-                             "\" (expected \"static\" or \"initial\")");
-    // From the model's initial configuration (solve_static starts there; so does y0).
-    Data data(model);
-    StaticOptions statics;
-    statics.time = 0.0;
-    statics.structure_cache = context_->structure_cache;
-    const StaticResult equilibrium = solve_static(model, statics, data);
-    if (std::chrono::steady_clock::now() > context_->deadline) {
-      context_->timed_out = true;
-      return fail(error,
-                  "timeout: the run exceeded its max_seconds budget (in the modal "
-                  "integrator's static solve)");
-    }
-    std::string why;
-    if (!equilibrium.ok) {
-      why = "no static equilibrium under the loads at t = 0 (" + equilibrium.message + ")";
-    } else {
-      for (int b = 0; b < model.n_free() && why.empty(); ++b) {
-        const int body = model.free_bodies[b];
-        const double* r = reference.data() + kS * b;
-        const Mat3 a0 = rotation_matrix<double>(Vec4(r[3], r[4], r[5], r[6]));
-        if (rotation_vector(data.pose[body].A * a0.transpose()).norm() >
-            kModalIntegratorMaxRotation)
-          why = "in the static equilibrium under the loads at t = 0, body \"" +
-                model.bodies[body].name + "\" is turned more than " + rotation_limit_text() +
-                " from its initial orientation";
-      }
-    }
-    if (!why.empty()) {
-      if (options_.about == "static")
-        return fail(error, "the modal integrator: " + why +
-                               "; \"about\": \"initial\" linearizes "
-                               "about the initial state");
-      warnings.push_back("the modal integrator linearized about the initial state: " + why +
-                         (equilibrium.ok ? " (the run stops if a body turns more than " +
-                                               rotation_limit_text() + " from there)"
-                                         : ""));
-      return true;
-    }
-    for (int b = 0; b < model.n_free(); ++b) {
-      const int body = model.free_bodies[b];
-      double* r = reference.data() + kS * b;
-      const Vec3 c = centre(model, data, body);
-      for (int j = 0; j < 3; ++j) r[j] = c(j);
-      for (int j = 0; j < 4; ++j) r[3 + j] = data.q[body](j);
-      for (int j = 7; j < kS; ++j) r[j] = 0.0;
-    }
-    return true;
   }
 
   // The modes of the band (dense eigensolver up to kModalIntegratorMaxDofs, else shift-invert

@@ -34,16 +34,26 @@ inline TransientRun simulate(const Model& model, const TransientOptions& options
   return r;
 }
 
+// For body b over the common samples: the largest distance between the runs' centres and the
+// largest distance the body moved in the reference.
+struct BodyDeviation {
+  double error = 0.0, motion = 0.0;
+};
+inline BodyDeviation body_deviation(const TransientRun& run, const TransientRun& reference, int b) {
+  BodyDeviation d;
+  const Vec3 start = reference.samples.front().c[b];
+  for (const auto& s : reference.samples) d.motion = std::max(d.motion, (s.c[b] - start).norm());
+  const size_t n = std::min(run.samples.size(), reference.samples.size());
+  for (size_t k = 0; k < n; ++k)
+    d.error = std::max(d.error, (run.samples[k].c[b] - reference.samples[k].c[b]).norm());
+  return d;
+}
+
 // Largest distance of body b's centre from its reference position over the common samples,
 // relative to its largest motion in the reference.
 inline double motion_error(const TransientRun& run, const TransientRun& reference, int b) {
-  double error = 0.0, motion = 0.0;
-  const Vec3 start = reference.samples.front().c[b];
-  for (const auto& s : reference.samples) motion = std::max(motion, (s.c[b] - start).norm());
-  const size_t n = std::min(run.samples.size(), reference.samples.size());
-  for (size_t k = 0; k < n; ++k)
-    error = std::max(error, (run.samples[k].c[b] - reference.samples[k].c[b]).norm());
-  return error / motion;
+  const BodyDeviation d = body_deviation(run, reference, b);
+  return d.error / d.motion;
 }
 
 // Largest distance between the runs' free-body centres over the common samples, relative to the
@@ -52,11 +62,9 @@ inline double run_error(const Model& model, const TransientRun& run,
                         const TransientRun& reference) {
   double error = 0.0, motion = 0.0;
   for (int b : model.free_bodies) {
-    const Vec3 start = reference.samples.front().c[b];
-    for (const auto& s : reference.samples) motion = std::max(motion, (s.c[b] - start).norm());
-    const size_t n = std::min(run.samples.size(), reference.samples.size());
-    for (size_t k = 0; k < n; ++k)
-      error = std::max(error, (run.samples[k].c[b] - reference.samples[k].c[b]).norm());
+    const BodyDeviation d = body_deviation(run, reference, b);
+    error = std::max(error, d.error);
+    motion = std::max(motion, d.motion);
   }
   return error / motion;
 }

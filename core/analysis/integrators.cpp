@@ -110,6 +110,10 @@ SolverStats& operator+=(SolverStats& a, const SolverStats& b) {
 // What the SUNDIALS integrators share: max_steps over the whole run (SUNDIALS counts them per call
 // and resets its counters when it restarts at a load's jump), statistics over the whole run, and a
 // check of the state after each call.
+constexpr const char* kFixedStepWarning =
+    "fixed_step: every step has the given length and no error is estimated (rtol and atol only "
+    "set the Newton tolerance); measure the error by halving the step";
+
 class SundialsIntegrator : public Integrator {
  public:
   int advance(double tout, double tstop, N_Vector y, double* t) final {
@@ -131,8 +135,12 @@ class SundialsIntegrator : public Integrator {
     return s;
   }
   std::string failure(int flag) const final {
-    return explain(flag, package_, flag < 0 && flag != kNonFiniteState ? name(flag) : "",
-                   messages_.last, *context_, max_steps_);
+    std::string why = explain(flag, package_, flag < 0 && flag != kNonFiniteState ? name(flag) : "",
+                              messages_.last, *context_, max_steps_);
+    if (fixed_step_ && !context_->interrupted && !context_->timed_out)
+      why += "; with fixed_step the step cannot shrink: try a shorter fixed_step, or a looser rtol "
+             "(the Newton tolerance)";
+    return why;
   }
 
  protected:
@@ -153,6 +161,7 @@ class SundialsIntegrator : public Integrator {
   SundialsMessages messages_;
   long max_steps_ = 0;
   std::string package_;
+  bool fixed_step_ = false;
 
  private:
   SolverStats before_;  // up to the last restart
@@ -288,6 +297,12 @@ class ArkodeImplicit : public SundialsIntegrator {
     ARKStepSetPredictorMethod(mem_, 2);
     if (o.max_step > 0.0) ARKStepSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) ARKStepSetInitStep(mem_, o.initial_step);
+    if (o.fixed_step > 0.0) {
+      if (ARKStepSetFixedStep(mem_, o.fixed_step) < 0)
+        return fail(error, "ARKODE refused fixed_step: " + messages_.last);
+      warnings.push_back(kFixedStepWarning);
+      fixed_step_ = true;
+    }
     return true;
   }
   ~ArkodeImplicit() override { ARKStepFree(&mem_); }
@@ -335,6 +350,12 @@ class ArkodeExplicit : public SundialsIntegrator {
     ERKStepSetPostprocessStepFn(mem_, ode_normalize);
     if (o.max_step > 0.0) ERKStepSetMaxStep(mem_, o.max_step);
     if (o.initial_step > 0.0) ERKStepSetInitStep(mem_, o.initial_step);
+    if (o.fixed_step > 0.0) {
+      if (ERKStepSetFixedStep(mem_, o.fixed_step) < 0)
+        return fail(error, "ARKODE refused fixed_step: " + messages_.last);
+      warnings.push_back(kFixedStepWarning);
+      fixed_step_ = true;
+    }
     return true;
   }
   ~ArkodeExplicit() override { ERKStepFree(&mem_); }

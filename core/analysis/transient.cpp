@@ -101,6 +101,12 @@ bool IntegratorOptions::IsValid(std::string* error) const {
     return refuse(error, "max_step must be 0 (no limit) or positive and finite");
   if (!zero_or_positive_finite(initial_step))
     return refuse(error, "initial_step must be 0 (the integrator's estimate) or positive");
+  if (!zero_or_positive_finite(fixed_step))
+    return refuse(error, "fixed_step must be 0 (adaptive steps) or positive and finite");
+  if (fixed_step > 0.0 && method != IntegratorMethod::kDirk && method != IntegratorMethod::kErk)
+    return refuse(error, "fixed_step applies to the \"dirk\" and \"erk\" methods");
+  if (fixed_step > 0.0 && (max_step > 0.0 || initial_step > 0.0))
+    return refuse(error, "fixed_step sets every step: max_step and initial_step do not apply");
   if (max_steps < 1) return refuse(error, "max_steps must be at least 1");
   if (!about.empty() && about != "static" && about != "initial")
     return refuse(error, "about must be \"static\", \"initial\" or empty");

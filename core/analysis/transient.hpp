@@ -49,6 +49,11 @@ struct IntegratorOptions {
   bool stability_limit_detection = false;  // CVODE's BDF stability limit detection
   double max_step = 0.0;                   // [s]; 0: no limit
   double initial_step = 0.0;               // [s]; 0: the integrator's estimate
+  // dirk, erk: every step this long [s] (the last before a breakpoint or t_end shorter), no error
+  // control: rtol and atol only set the implicit stages' Newton tolerance. For references whose
+  // error is measured by halving the step (an undamped stiff scene makes an adaptive implicit
+  // method resolve modes an L-stable fixed step damps). 0: adaptive steps.
+  double fixed_step = 0.0;
   long max_steps = 10000000;               // step budget of the whole run (all output steps)
   // modal: the configuration linearized about: "static" (the equilibrium under the loads at
   // t = 0), "initial" (the initial state), "" (static when that equilibrium is found within

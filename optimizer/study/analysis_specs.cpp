@@ -54,6 +54,14 @@ void read_integrator(const Json& value, const Where& where, Diagnostics& diag,
   }
   io.max_step = r.positive("max_step", false).value_or(0.0);
   io.initial_step = r.positive("initial_step", false).value_or(0.0);
+  if (const auto h = r.positive("fixed_step", false)) {
+    if (io.method != IntegratorMethod::kDirk && io.method != IntegratorMethod::kErk)
+      r.error("fixed_step", "applies to the \"dirk\" and \"erk\" methods");
+    else if (io.max_step > 0.0 || io.initial_step > 0.0)
+      r.error("fixed_step", "sets every step: max_step and initial_step do not apply with it");
+    else
+      io.fixed_step = *h;
+  }
   io.max_steps = r.integer("max_steps", false, 1).value_or(io.max_steps);
   if (const Json* band = r.member("max_frequency_hz", false)) {
     const bool chosen = band->is_string() && band->get<std::string>() == "auto";

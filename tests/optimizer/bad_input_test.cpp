@@ -303,6 +303,7 @@ TEST_F(BadInput, IntegratorOptionsOfAnotherMethod) {
       {"about", "initial", "applies to the \"modal\" and \"auto\" methods"},
       {"max_frequency_hz", 100.0, "applies to the \"modal\" and \"auto\" methods"},
       {"stability_limit_detection", true, "applies to the \"bdf\" method"},
+      {"fixed_step", 1e-4, "applies to the \"dirk\" and \"erk\" methods"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.key);
@@ -313,6 +314,19 @@ TEST_F(BadInput, IntegratorOptionsOfAnotherMethod) {
     const Result r = check(study);
     EXPECT_TRUE(
         HasOnlyError(r, std::string("bad.json:/analyses/0/integrator/") + c.key + ":", c.message));
+  }
+}
+
+// fixed_step sets every step: with max_step or initial_step the file contradicts itself.
+TEST_F(BadInput, FixedStepWithAStepLimit) {
+  for (const char* limit : {"max_step", "initial_step"}) {
+    SCOPED_TRACE(limit);
+    Json study = base();
+    study["analyses"][0]["integrator"]["method"] = "dirk";
+    study["analyses"][0]["integrator"][limit] = 1e-3;
+    study["analyses"][0]["integrator"]["fixed_step"] = 1e-4;
+    EXPECT_TRUE(HasOnlyError(check(study), "bad.json:/analyses/0/integrator/fixed_step:",
+                             "max_step and initial_step do not apply"));
   }
 }
 

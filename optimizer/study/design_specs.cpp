@@ -321,6 +321,11 @@ void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
           method.label += band;
         }
         if (io.choose_band) method.label += " band auto";
+        if (io.fixed_step > 0.0) {
+          char step[48];
+          std::snprintf(step, sizeof step, " fixed_step %g s", io.fixed_step);
+          method.label += step;
+        }
         if (io.linear_solver != LinearSolverKind::kAuto)
           method.label.append(io.linear_solver == LinearSolverKind::kDense ? " dense" : " sparse");
         p.methods.push_back(method);

@@ -862,18 +862,23 @@ TEST_F(DesignStudyRuns, WorkPrecisionStudyTabulatesEveryMethodAndToleranceAgains
 }
 
 // The band's trade in a work-precision table: a band-limited row is labelled with its band, takes
-// fewer steps than the full model and shows the error it costs against the full reference.
-TEST_F(DesignStudyRuns, WorkPrecisionShowsWhatABandCosts) {
+// fewer steps than the full model and shows the error it costs against the full reference; a
+// fixed step's row is labelled with it and takes exactly its steps.
+TEST_F(DesignStudyRuns, WorkPrecisionShowsWhatABandOrAFixedStepCosts) {
   Json s = small_work_precision();
   s["scene"]["beams"][0]["segments"] = 10;
-  s["study"]["methods"] =
-      Json::parse(R"([{"method": "auto"}, {"method": "auto", "max_frequency_hz": 500}])");
+  s["study"]["methods"] = Json::parse(R"([{"method": "auto"}, {"method": "auto", "max_frequency_hz": 500},
+                                          {"method": "dirk", "fixed_step": 1e-4}])");
   s["study"]["rtols"] = Json{1e-6};
   ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
   const Table t = read_table(dir_ / "wp" / "work_precision.csv");
-  ASSERT_EQ(t.rows.size(), 2u);
+  ASSERT_EQ(t.rows.size(), 3u);
   EXPECT_EQ(t.at(0, "method"), "auto");
   EXPECT_EQ(t.at(1, "method"), "auto band 500 Hz");
+  EXPECT_EQ(t.at(2, "method"), "dirk fixed_step 0.0001 s");
+  EXPECT_EQ(t.at(2, "steps"), "200");  // 0.02 s
+  std::printf("fixed step 1e-4 s: error %s\n", t.at(2, "error").c_str());
+  EXPECT_LT(std::stod(t.at(2, "error")), 1e-4);
   const double full = std::stod(t.at(0, "error")), band = std::stod(t.at(1, "error"));
   std::printf("full model: error %.2e, %s steps; band 500 Hz: error %.2e, %s steps\n", full,
               t.at(0, "steps").c_str(), band, t.at(1, "steps").c_str());

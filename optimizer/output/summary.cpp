@@ -111,7 +111,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       j["energy_final"] = json_number(a.energy_final);
       j["energy_max_change"] = json_number(a.energy_max_change);
       j["energy_max_relative_change"] = json_number(a.energy_max_relative_change);
-      if (const auto& v = a.verification)
+      if (const auto& v = a.verification) {
         j["verification"] = {
             {"status", v->ok ? status_name(Status::kOk) : status_name(Status::kFailed)},
             {"message", v->message},
@@ -125,6 +125,8 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
             {"steps", v->stats.steps},
             {"rhs_evaluations", v->stats.rhs_evaluations},
             {"jacobian_evaluations", v->stats.jacobian_evaluations}};
+        if (v->fixed_step > 0.0) j["verification"]["fixed_step"] = v->fixed_step;
+      }
     }
     if (a.statics) {
       const StaticResult& r = *a.statics;

@@ -27,6 +27,7 @@ struct Verification {
   bool ok = false;
   std::string message;
   double rtol = 0.0, atol = 0.0;  // of the tighter run
+  double fixed_step = 0.0;        // of the tighter run (half the run's); 0: adaptive
   double error = 0.0;             // largest body-centre distance between the runs / largest motion
   SolverStats stats;              // of the tighter run
 };

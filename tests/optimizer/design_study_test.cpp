@@ -924,6 +924,7 @@ TEST_F(DesignStudyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightRefere
   EXPECT_EQ(v["status"], "ok");
   EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-7);
   EXPECT_DOUBLE_EQ(v["atol"].get<double>(), 1e-11);
+  EXPECT_FALSE(v.contains("fixed_step"));
   EXPECT_GT(v["steps"].get<long>(), summary["analyses"][0]["steps"].get<long>());
   const double estimate = v["error"];
   std::printf(
@@ -933,6 +934,37 @@ TEST_F(DesignStudyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightRefere
   // [2/3, 4/3] of the true error.
   EXPECT_GT(estimate / measured, 2.0 / 3.0);
   EXPECT_LT(estimate / measured, 4.0 / 3.0);
+}
+
+// A fixed step sets its run's error whatever rtol: "verify" reruns it at half the step (a tighter
+// rtol alone would rerun the same steps and call the run exact).
+TEST_F(DesignStudyRuns, VerifyHalvesAFixedStep) {
+  Json wp = small_work_precision();
+  wp["study"]["methods"] = Json::parse(R"([{"method": "dirk", "fixed_step": 4e-4}])");
+  wp["study"]["rtols"] = Json{1e-8};
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp"));
+  const double measured = std::stod(read_table(dir_ / "wp" / "work_precision.csv").at(0, "error"));
+
+  Json single = wp;
+  single.erase("study");
+  single["analyses"][0]["integrator"] =
+      Json{{"method", "dirk"}, {"fixed_step", 4e-4}, {"rtol", 1e-8}, {"atol", 1e-12}};
+  single["analyses"][0]["verify"] = true;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("single.json", single), "single"));
+  const Json summary = load_json(dir_ / "single" / "summary.json");
+  const Json& v = summary["analyses"][0]["verification"];
+  ASSERT_TRUE(v.is_object()) << summary.dump(2);
+  EXPECT_EQ(v["status"], "ok");
+  EXPECT_DOUBLE_EQ(v["fixed_step"].get<double>(), 2e-4);
+  EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-8);  // the Newton tolerance kept
+  EXPECT_EQ(summary["analyses"][0]["steps"], 50);  // 0.02 s
+  EXPECT_EQ(v["steps"], 100);
+  const double estimate = v["error"];
+  std::printf("dirk fixed step 4e-4 s: error %.4g against rtol 1e-11, %.4g against 2e-4 s "
+              "(ratio %.3f)\n", measured, estimate, estimate / measured);
+  // At order 5 the rerun's own error is 1/32 of the run's: the estimate is within a few percent.
+  EXPECT_GT(estimate / measured, 0.9);
+  EXPECT_LT(estimate / measured, 1.1);
 }
 
 TEST_F(DesignStudyRuns, ADesignPastItsBudgetIsATimeoutRowAndTheBatchGoesOn) {

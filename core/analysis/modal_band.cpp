@@ -64,11 +64,14 @@ bool change_after(const TimeFunction& f, double t0, double* rate, double* factor
 
 }  // namespace
 
+// The times at which an early run's motion is sampled (choose_band's horizon).
+constexpr int kHorizonSamples = 32;
+
 BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi,
                        const Eigen::SparseMatrix<double>& m0,
                        const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& shifted, double mu,
                        const std::vector<BandExcitation>& excitations,
-                       const std::vector<int>& watched, double tolerance) {
+                       const std::vector<int>& watched, double tolerance, double horizon) {
   const Eigen::Index total = lambda.size();
   BandChoice choice;
   if (total == 0) return choice;
@@ -139,9 +142,34 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
         break;
     }
     const double size = e.kind == BandExcitation::Kind::kVelocity ? 1.0 / w(0) : 1.0;
-    for (int part = 0; part < 2; ++part)
-      for (Eigen::Index r : rows_of(part))
-        scale[part] = std::max(scale[part], size * std::abs(elastic(r)));
+    // Within a quarter of the lowest elastic period a jump or a velocity has not moved that far
+    // yet: its modes' linear response up to the horizon (the modes beyond those given respond
+    // at once: their static part counts in full for a jump).
+    const bool early = horizon > 0.0 && lowest_positive > 0.0 && (e.rate == 0.0) &&
+                       horizon * std::sqrt(lowest_positive) < 0.5 * std::numbers::pi;
+    for (int part = 0; part < 2; ++part) {
+      const std::vector<Eigen::Index> rows = rows_of(part);
+      double reached = 0.0;
+      if (early) {
+        Eigen::VectorXd beyond = elastic;  // the response of the modes beyond those given
+        for (Eigen::Index k = rigid; k < total; ++k) beyond -= t.coefficients(k) * phi.col(k);
+        const bool jump = e.kind == BandExcitation::Kind::kForce;
+        for (int j = 1; j <= kHorizonSamples; ++j) {
+          const double time = horizon * j / kHorizonSamples;
+          for (Eigen::Index r : rows) {
+            double x = jump ? beyond(r) : 0.0;
+            for (Eigen::Index k = rigid; k < total; ++k)
+              x += t.coefficients(k) * phi(r, k) *
+                   (jump ? 1.0 - std::cos(w(k) * time) : std::sin(w(k) * time) / w(k));
+            reached = std::max(reached, std::abs(x));
+          }
+        }
+      }
+      for (Eigen::Index r : rows) {
+        const double full = size * std::abs(elastic(r));
+        scale[part] = std::max(scale[part], early ? std::min(full, reached) : full);
+      }
+    }
     tracks.push_back(std::move(t));
   }
   if (!(scale[0] > 0.0) && !(scale[1] > 0.0) && least <= total) {  // nothing rings
@@ -269,7 +297,7 @@ bool solve_band_modes(const Model& model, const Data& data, double t0,
                       const Eigen::SparseMatrix<double>& k0, const Eigen::SparseMatrix<double>& m0,
                       double band_hz, const std::vector<BandExcitation>& excitations,
                       const std::vector<int>& watched, double rtol, double max_seconds,
-                      BandModes& out, std::string* error) {
+                      BandModes& out, std::string* error, double horizon) {
   const bool choose = !(band_hz > 0.0);
   double limit = choose ? 0.0 : std::pow(2.0 * std::numbers::pi * band_hz, 2);
   const Eigen::Index n = model.n_dofs;
@@ -289,7 +317,7 @@ bool solve_band_modes(const Model& model, const Data& data, double t0,
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> shifted(
         Eigen::SparseMatrix<double>(k0 + mu * m0));
     if (shifted.info() != Eigen::Success) return false;
-    chosen = choose_band(values, vectors, m0, shifted, mu, excitations, watched, rtol);
+    chosen = choose_band(values, vectors, m0, shifted, mu, excitations, watched, rtol, horizon);
     return true;
   };
   if (n <= kModalIntegratorMaxDofs) {

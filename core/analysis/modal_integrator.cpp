@@ -229,8 +229,9 @@ class ModalExponential : public Integrator {
         std::chrono::duration<double>(context_->deadline - std::chrono::steady_clock::now())
             .count();
     BandModes band;
+    const double horizon = options_.horizon > t0 ? options_.horizon - t0 : 0.0;
     if (!solve_band_modes(model, data, t0, k0, m0_, choose ? 0.0 : band_hz_, excitations, watched,
-                          options_.rtol, seconds, band, error))
+                          options_.rtol, seconds, band, error, horizon))
       return false;
     m_ = band.kept;
     const double limit = band.top;

@@ -146,7 +146,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     result.message = "invalid transient options: " + result.message;
     return result;
   }
-  const IntegratorOptions& io = options.integrator;
+  IntegratorOptions io = options.integrator;
+  io.horizon = options.t_end;
   DeformationCheck deformation(model);
   try {
     SundialsContext ctx;

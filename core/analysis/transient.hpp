@@ -69,6 +69,10 @@ struct IntegratorOptions {
   // the fewest modes whose dropped ringing is estimated within rtol of the motion; study files'
   // "max_frequency_hz": "auto"). auto chooses it itself for large scenes.
   bool choose_band = false;
+  // The run's end [s] (run_transient sets it to t_end): a chosen band's estimate sizes the motion
+  // of a run shorter than a quarter of the lowest period by what it reaches (modal_band.hpp).
+  // 0: unbounded.
+  double horizon = 0.0;
 
   // Whether the options can run: true, or false with the first problem in *error (a tolerance
   // not positive, an order outside the method's range, an option of another method). The

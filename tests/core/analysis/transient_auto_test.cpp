@@ -235,7 +235,8 @@ TEST(TransientAuto, HeavyDampingTakesBdf) {
 TEST(TransientAuto, BeyondTheModalLimitChoosesABandOrTakesBdf) {
   const int bodies = kModalIntegratorMaxDofs / kDofsPerBody + 1;
   const Model model = scene_from_json(reference_cantilever(bodies));
-  const TransientRun run = run_with(model, "auto", 1e-5, 1e-5, 1e-6);
+  // Over 0.05 s (past a quarter of the lowest period: the motion is the static response's size).
+  const TransientRun run = run_with(model, "auto", 0.05, 0.01, 1e-6);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   ASSERT_EQ(run.result.phases.size(), 1u);
   EXPECT_EQ(run.result.phases[0].method, "modal");
@@ -251,7 +252,11 @@ TEST(TransientAuto, BeyondTheModalLimitChoosesABandOrTakesBdf) {
   EXPECT_EQ(all, kDofsPerBody * bodies);
   EXPECT_GT(modes, 20);
   EXPECT_LT(modes, 200);
-  // rtol 1e-12 asks for more than kModalChosenBandMaxModes modes.
+  // rtol 1e-12 asks for more than kModalChosenBandMaxModes modes; so does rtol 1e-6 over 10 us,
+  // where the high modes are most of what moves.
+  const TransientRun early = run_with(model, "auto", 1e-5, 1e-5, 1e-6);
+  ASSERT_TRUE(early.result.ok) << early.result.message;
+  EXPECT_EQ(early.result.phases[0].method, "bdf");
   const TransientRun tight = run_with(model, "auto", 1e-5, 1e-5, 1e-12);
   ASSERT_TRUE(tight.result.ok) << tight.result.message;
   ASSERT_EQ(tight.result.phases.size(), 1u);
@@ -259,6 +264,41 @@ TEST(TransientAuto, BeyondTheModalLimitChoosesABandOrTakesBdf) {
   EXPECT_NE(tight.result.phases[0].reason.find("no band of the 400 lowest modes"),
             std::string::npos)
       << tight.result.phases[0].reason;
+}
+
+// Beyond the dense solver's size the band comes from Lanczos: measured against a run of another
+// method, the default DIRK table at a fixed step (L-stable: it damps the modes its step cannot
+// resolve), whose own error is measured by halving that step.
+TEST(TransientAuto, TheLanczosBandMeetsRtolAgainstAFixedStepImplicitRun) {
+  const int bodies = kModalIntegratorMaxDofs / kDofsPerBody + 1;
+  const Model model = scene_from_json(reference_cantilever(bodies));
+  const double t_end = 0.01, output_step = 2e-4;
+  TransientRun references[2];
+  for (int k = 0; k < 2; ++k) {
+    TransientOptions o = options(t_end, output_step, 1e-10, 1e-9);  // the Newton tolerance
+    o.integrator.method = IntegratorMethod::kDirk;
+    o.integrator.fixed_step = 1e-5 / (1 << k);
+    references[k] = simulate(model, o);
+    ASSERT_TRUE(references[k].result.ok) << references[k].result.message;
+  }
+  const TransientRun& reference = references[1];
+  const double halving = run_error(model, references[0], reference);
+  // rtol 1e-6 would need a finer reference: the 10 us run is 1.5e-6 from the 5 us one.
+  for (double rtol : {1e-4, 1e-5}) {
+    const TransientRun run = run_with(model, "auto", t_end, output_step, rtol);
+    ASSERT_TRUE(run.result.ok) << run.result.message;
+    ASSERT_EQ(run.result.phases.size(), 1u);
+    EXPECT_NE(run.result.phases[0].reason.find("chosen for rtol"), std::string::npos)
+        << run.result.phases[0].reason;
+    const double e = run_error(model, run, reference);
+    std::printf("%d bodies, rtol %.0e: %s; error %.2e (%.2f rtol) against the fixed step 5 us, "
+                "whose own error is below %.1e (the 10 us run's distance), %ld steps\n",
+                bodies, rtol, run.result.phases[0].reason.c_str(), e, e / rtol, halving,
+                run.result.stats.steps);
+    EXPECT_LT(halving, 0.1 * e);  // the reference is good enough to measure this run
+    EXPECT_LT(e, 10 * rtol);      // the window: [1e-3, 10] rtol
+    EXPECT_GT(e, 1e-3 * rtol);
+  }
 }
 
 // Band-limited runs (max_frequency_hz) on the reference cantilever in 10 segments against the

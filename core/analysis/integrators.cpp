@@ -138,8 +138,9 @@ class SundialsIntegrator : public Integrator {
     std::string why = explain(flag, package_, flag < 0 && flag != kNonFiniteState ? name(flag) : "",
                               messages_.last, *context_, max_steps_);
     if (fixed_step_ && !context_->interrupted && !context_->timed_out)
-      why += "; with fixed_step the step cannot shrink: try a shorter fixed_step, or a looser rtol "
-             "(the Newton tolerance)";
+      why +=
+          "; with fixed_step the step cannot shrink: try a shorter fixed_step, or a looser rtol "
+          "(the Newton tolerance)";
     return why;
   }
 

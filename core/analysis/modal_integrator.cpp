@@ -298,8 +298,8 @@ class ModalExponential : public Integrator {
     const Model& model = context_->model;
     Data& data = context_->data;
     set_state(model, data, y13_.data());
-    compute_wrenches(model, data, t_);
-    compute_tangent(model, data, t_, false);
+    compute_wrenches(model, data, context_->force_time(t_));
+    compute_tangent(model, data, context_->force_time(t_), false);
     Eigen::SparseMatrix<double> k = -stiffness_matrix(model, data);
     k = 0.5 * Eigen::SparseMatrix<double>(k + Eigen::SparseMatrix<double>(k.transpose()));
     k0_.factorize(Eigen::SparseMatrix<double>(k + shift_ * m0_));
@@ -370,7 +370,8 @@ class ModalExponential : public Integrator {
   // The accelerations (dv/dt, d^2 theta/dt^2) into acceleration_ at the physical state x whose
   // 13 states states_of has just written into y13_; false when they are not finite.
   bool accelerations(double t, const Block& x) {
-    state_derivative(context_->model, context_->data, t, y13_.data(), ydot13_.data());
+    state_derivative(context_->model, context_->data, context_->force_time(t), y13_.data(),
+                     ydot13_.data());
     ++stats_.rhs_evaluations;
     for (size_t b = 0; b < c0_.size(); ++b) {
       const double* d = ydot13_.data() + kS * b;

@@ -64,7 +64,7 @@ int ode_rhs(double t, N_Vector y, N_Vector ydot, void* user_data) {
     const long n = c->model.n_states;
     for (long i = 0; i < n; ++i)
       if (!std::isfinite(s[i])) return non_finite(c, t, "state");
-    state_derivative(c->model, c->data, t, s, f);
+    state_derivative(c->model, c->data, c->force_time(t), s, f);
     for (long i = 0; i < n; ++i)
       if (!std::isfinite(f[i])) return non_finite(c, t, "forces");
     if (c->data.out_of_range) return out_of_range(c, t);
@@ -76,7 +76,7 @@ int ode_dense_jacobian(double t, N_Vector y, N_Vector, SUNMatrix jac, void* user
                        N_Vector, N_Vector) {
   auto* c = static_cast<OdeContext*>(user_data);
   return guarded(c, [&] {
-    state_jacobian_blocks(c->model, c->data, t, N_VGetArrayPointer(y), c->blocks);
+    state_jacobian_blocks(c->model, c->data, c->force_time(t), N_VGetArrayPointer(y), c->blocks);
     scatter_dense(c->model, c->blocks, SUNDenseMatrix_Data(jac), SUNDenseMatrix_Rows(jac));
     const long n = c->model.n_states;
     const double* a = SUNDenseMatrix_Data(jac);
@@ -90,7 +90,7 @@ int ode_sparse_jacobian(double t, N_Vector y, N_Vector, SUNMatrix jac, void* use
                         N_Vector, N_Vector) {
   auto* c = static_cast<OdeContext*>(user_data);
   return guarded(c, [&] {
-    state_jacobian_blocks(c->model, c->data, t, N_VGetArrayPointer(y), c->blocks);
+    state_jacobian_blocks(c->model, c->data, c->force_time(t), N_VGetArrayPointer(y), c->blocks);
     const JacobianPattern& p = c->structure->pattern();
     sunindextype* starts = SUNSparseMatrix_IndexPointers(jac);
     sunindextype* rows = SUNSparseMatrix_IndexValues(jac);

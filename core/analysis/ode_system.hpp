@@ -10,6 +10,8 @@
 #include <sundials/sundials_matrix.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,6 +45,18 @@ struct OdeContext {
   // recoverable failure of the right-hand side), described: why the integrator gave up, if it
   // did so over failures of the right-hand side.
   std::string out_of_range;
+  // The end of the current stretch between the loads' breakpoints or t_end (the transient
+  // analysis sets it): a jump there belongs to the next stretch, so the forces at or past it are those just
+  // before it. A step's last stage (c = 1) at the jump once saw the load on: dirk and erk moved
+  // before a step load at 10.05 ms (8 % of the motion off; the step before it held the whole
+  // load in its last stage and its interpolated outputs).
+  double stretch_end = std::numeric_limits<double>::infinity();
+
+  // The time the forces are evaluated at for the integrator's time t.
+  double force_time(double t) const {
+    return t >= stretch_end ? std::nextafter(stretch_end, -std::numeric_limits<double>::infinity())
+                            : t;
+  }
 
   // True, with timed_out or interrupted set, when the run must end now.
   bool should_stop() {

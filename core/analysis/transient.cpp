@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
-#include <limits>
 #include <stdexcept>
 
 #include "core/analysis/deformation_check.hpp"
@@ -208,6 +207,9 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
           integrator->restart(t, y);
           continue;
         }
+        // A jump at the stretch's end (or at t_end) acts after it: the forces there are its left
+        // limit.
+        context.stretch_end = stop;
         const int flag = integrator->advance(std::min(t_out, stop), stop, y, &t);
         if (flag < 0) {
           result.ok = false;

@@ -867,7 +867,8 @@ TEST_F(DesignStudyRuns, WorkPrecisionStudyTabulatesEveryMethodAndToleranceAgains
 TEST_F(DesignStudyRuns, WorkPrecisionShowsWhatABandOrAFixedStepCosts) {
   Json s = small_work_precision();
   s["scene"]["beams"][0]["segments"] = 10;
-  s["study"]["methods"] = Json::parse(R"([{"method": "auto"}, {"method": "auto", "max_frequency_hz": 500},
+  s["study"]["methods"] =
+      Json::parse(R"([{"method": "auto"}, {"method": "auto", "max_frequency_hz": 500},
                                           {"method": "dirk", "fixed_step": 1e-4}])");
   s["study"]["rtols"] = Json{1e-6};
   ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
@@ -957,11 +958,13 @@ TEST_F(DesignStudyRuns, VerifyHalvesAFixedStep) {
   EXPECT_EQ(v["status"], "ok");
   EXPECT_DOUBLE_EQ(v["fixed_step"].get<double>(), 2e-4);
   EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-8);  // the Newton tolerance kept
-  EXPECT_EQ(summary["analyses"][0]["steps"], 50);  // 0.02 s
+  EXPECT_EQ(summary["analyses"][0]["steps"], 50);   // 0.02 s
   EXPECT_EQ(v["steps"], 100);
   const double estimate = v["error"];
-  std::printf("dirk fixed step 4e-4 s: error %.4g against rtol 1e-11, %.4g against 2e-4 s "
-              "(ratio %.3f)\n", measured, estimate, estimate / measured);
+  std::printf(
+      "dirk fixed step 4e-4 s: error %.4g against rtol 1e-11, %.4g against 2e-4 s "
+      "(ratio %.3f)\n",
+      measured, estimate, estimate / measured);
   // At order 5 the rerun's own error is 1/32 of the run's: the estimate is within a few percent.
   EXPECT_GT(estimate / measured, 0.9);
   EXPECT_LT(estimate / measured, 1.1);

@@ -106,8 +106,9 @@ TEST(Integrators, FixedStepsTakeTheirLengthAndConvergeAtTheTablesOrder) {
   };
   // The explicit table is stable up to about 5e-5 s here and within the reference's own error
   // (2e-12) by 2e-5 s: no range to measure its order in; one run against the reference.
-  for (const Case c : {Case{"dirk", "", 5, 4e-4, 3}, Case{"dirk", "ARK437L2SA_DIRK_7_3_4", 4, 4e-4, 3},
-                       Case{"erk", "", 5, 3e-5, 1}}) {
+  for (const Case c :
+       {Case{"dirk", "", 5, 4e-4, 3}, Case{"dirk", "ARK437L2SA_DIRK_7_3_4", 4, 4e-4, 3},
+        Case{"erk", "", 5, 3e-5, 1}}) {
     double previous = 0.0;
     for (int k = 0; k < c.runs; ++k) {
       const double h = c.h0 / std::pow(2.0, k);

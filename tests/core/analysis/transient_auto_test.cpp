@@ -291,10 +291,11 @@ TEST(TransientAuto, TheLanczosBandMeetsRtolAgainstAFixedStepImplicitRun) {
     EXPECT_NE(run.result.phases[0].reason.find("chosen for rtol"), std::string::npos)
         << run.result.phases[0].reason;
     const double e = run_error(model, run, reference);
-    std::printf("%d bodies, rtol %.0e: %s; error %.2e (%.2f rtol) against the fixed step 5 us, "
-                "whose own error is below %.1e (the 10 us run's distance), %ld steps\n",
-                bodies, rtol, run.result.phases[0].reason.c_str(), e, e / rtol, halving,
-                run.result.stats.steps);
+    std::printf(
+        "%d bodies, rtol %.0e: %s; error %.2e (%.2f rtol) against the fixed step 5 us, "
+        "whose own error is below %.1e (the 10 us run's distance), %ld steps\n",
+        bodies, rtol, run.result.phases[0].reason.c_str(), e, e / rtol, halving,
+        run.result.stats.steps);
     EXPECT_LT(halving, 0.1 * e);  // the reference is good enough to measure this run
     EXPECT_LT(e, 10 * rtol);      // the window: [1e-3, 10] rtol
     EXPECT_GT(e, 1e-3 * rtol);

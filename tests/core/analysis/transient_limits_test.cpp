@@ -196,12 +196,14 @@ TEST(TransientLimits, OptionsThatCannotRunAreRefusedNamingTheOption) {
          o.integrator.stability_limit_detection = true;
        }},
       {"max_steps", [](TransientOptions& o) { o.integrator.max_steps = 0; }},
-      {"fixed_step must be", [](TransientOptions& o) {
+      {"fixed_step must be",
+       [](TransientOptions& o) {
          o.integrator.method = IntegratorMethod::kDirk;
          o.integrator.fixed_step = -1e-4;
        }},
       {"fixed_step applies", [](TransientOptions& o) { o.integrator.fixed_step = 1e-4; }},
-      {"max_step and initial_step do not apply", [](TransientOptions& o) {
+      {"max_step and initial_step do not apply",
+       [](TransientOptions& o) {
          o.integrator.method = IntegratorMethod::kErk;
          o.integrator.fixed_step = 1e-4;
          o.integrator.max_step = 1e-3;

@@ -8,14 +8,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "tests/support/run_process.hpp"
+#include "tests/support/study_runs.hpp"
 
 #ifndef BEAMRAIL_EXECUTABLE
 #error "BEAMRAIL_EXECUTABLE must name the beamrail binary"
@@ -26,8 +23,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using testing::ProcessResult;
+using testing::read_table;
 using testing::read_text;
+using testing::Table;
 
 // A 1 m steel rod cantilever of diameter d under a 50 N m tip torque: it turns the tip by
 // theta = M L / (E I), I = pi d^4 / 64, and the beam's relative rotation is that angle. Past
@@ -60,61 +58,12 @@ double diameter_for(double theta) {
   return std::pow(64.0 * inertia / M_PI, 0.25);
 }
 
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-  const std::string& at(size_t row, const std::string& name) const {
-    for (size_t c = 0; c < header.size(); ++c)
-      if (header[c] == name) return rows.at(row).at(c);
-    throw std::runtime_error("no column " + name);
-  }
-};
-
-// CSV with quoted fields (doubled quotes inside).
-Table read_table(const fs::path& path) {
-  Table t;
-  std::istringstream in(read_text(path));
-  for (std::string line; std::getline(in, line);) {
-    std::vector<std::string> fields(1);
-    bool quoted = false;
-    for (size_t i = 0; i < line.size(); ++i) {
-      const char c = line[i];
-      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
-        fields.back() += '"', ++i;
-      else if (c == '"')
-        quoted = !quoted;
-      else if (c == ',' && !quoted)
-        fields.emplace_back();
-      else
-        fields.back() += c;
-    }
-    if (t.header.empty())
-      t.header = fields;
-    else
-      t.rows.push_back(fields);
-  }
-  return t;
-}
-
-class WarnedDesigns : public ::testing::Test {
+class WarnedDesigns : public testing::StudyRuns {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "beamrail_warned_XXXXXX").string();
-    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
   // Runs the study into `out`; it must succeed.
   void run_ok(const Json& study, const std::string& out) {
-    std::ofstream(dir_ / (out + ".json")) << study.dump(2);
-    const ProcessResult r = testing::run_process(
-        BEAMRAIL_EXECUTABLE, {"run", out + ".json", "-o", out, "--quiet"}, dir_);
-    ASSERT_TRUE(r.exited && r.status == 0) << r.how << "\n" << r.err;
+    StudyRuns::run_ok(write_study(out + ".json", study), out);
   }
-  fs::path dir_;
 };
 
 TEST_F(WarnedDesigns, SweepRowsCountTheWarningsAndCarryTheirTexts) {

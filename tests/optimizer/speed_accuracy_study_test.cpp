@@ -1,0 +1,239 @@
+// The speed-accuracy trade through the real command line (docs/study_files.md "work_precision",
+// `verify`, `max_seconds_per_design`): work-precision tables against a tight reference, what a
+// band or a fixed step costs, runs past their budget as timeout rows, `verify`'s estimate against
+// the error measured by a work-precision study, and designs past their budget in a batch.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tests/support/study_runs.hpp"
+
+#ifndef BEAMRAIL_STUDIES_DIR
+#error "BEAMRAIL_STUDIES_DIR must name the studies/ directory"
+#endif
+
+namespace beamrail {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using beamrail::testing::load_json;
+using beamrail::testing::read_table;
+using beamrail::testing::Table;
+
+const fs::path kStudies = BEAMRAIL_STUDIES_DIR;
+
+class SpeedAccuracyRuns : public testing::StudyRuns {};
+
+// The reference problem of studies/work_precision_reference.json cut to 3 segments and 0.02 s.
+Json small_work_precision() {
+  Json s = load_json(kStudies / "work_precision_reference.json");
+  s["scene"]["beams"][0]["segments"] = 3;
+  s["analyses"][0]["t_end"] = 0.02;
+  s["analyses"][0]["output_step"] = 2e-4;
+  s["study"]["methods"] = Json::parse(R"([{"method": "bdf"}, {"method": "dirk"},
+                                          {"method": "erk", "table": "VERNER_8_5_6"}])");
+  s["study"]["rtols"] = Json{1e-4, 1e-7};
+  s["study"]["target_error"] = 1e-5;
+  return s;
+}
+
+TEST_F(SpeedAccuracyRuns, WorkPrecisionStudyTabulatesEveryMethodAndToleranceAgainstTheReference) {
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", small_work_precision()), "wp"));
+  const Table t = read_table(dir_ / "wp" / "work_precision.csv");
+  const Json summary = load_json(dir_ / "wp" / "summary.json");
+  const std::vector<std::string> methods = {"bdf", "dirk", "erk VERNER_8_5_6"};
+  ASSERT_EQ(t.rows.size(), 6u);
+  double fastest = INFINITY;
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    const double error = std::stod(t.at(i, "error")), wall = std::stod(t.at(i, "wall_s"));
+    std::printf("%-18s rtol %s: error %.3g, %s steps, %s s\n", t.at(i, "method").c_str(),
+                t.at(i, "rtol").c_str(), error, t.at(i, "steps").c_str(),
+                t.at(i, "wall_s").c_str());
+    EXPECT_EQ(t.at(i, "method"), methods[i / 2]);
+    EXPECT_EQ(std::stod(t.at(i, "rtol")), i % 2 ? 1e-7 : 1e-4);
+    EXPECT_EQ(std::stod(t.at(i, "atol")), std::stod(t.at(i, "rtol")) * 1e-4);
+    EXPECT_EQ(t.at(i, "status"), "ok");
+    EXPECT_TRUE(std::isfinite(error) && error > 0.0) << i;
+    EXPECT_EQ(t.at(i, "jac_evals") == "0", methods[i / 2].rfind("erk", 0) == 0) << i;
+    if (error <= 1e-5) fastest = std::min(fastest, wall);
+  }
+  for (size_t i = 0; i < t.rows.size(); i += 2)  // a tighter tolerance is a smaller error
+    EXPECT_LT(std::stod(t.at(i + 1, "error")), std::stod(t.at(i, "error"))) << t.at(i, "method");
+  EXPECT_EQ(summary["type"], "work_precision");
+  EXPECT_EQ(summary["runs"], 6);
+  EXPECT_EQ(summary["failed_or_timeout"], 0);
+  EXPECT_EQ(summary["reference"]["rtol"], 1e-11);
+  ASSERT_TRUE(summary["fastest_within_target"].is_object()) << summary.dump(2);
+  EXPECT_LE(summary["fastest_within_target"]["error"].get<double>(), 1e-5);
+  EXPECT_EQ(summary["fastest_within_target"]["wall_seconds"].get<double>(), fastest);
+}
+
+// The band's trade in a work-precision table: a band-limited row is labelled with its band, takes
+// fewer steps than the full model and shows the error it costs against the full reference; a
+// fixed step's row is labelled with it and takes exactly its steps.
+TEST_F(SpeedAccuracyRuns, WorkPrecisionShowsWhatABandOrAFixedStepCosts) {
+  Json s = small_work_precision();
+  s["scene"]["beams"][0]["segments"] = 10;
+  s["study"]["methods"] =
+      Json::parse(R"([{"method": "auto"}, {"method": "auto", "max_frequency_hz": 500},
+                                          {"method": "dirk", "fixed_step": 1e-4}])");
+  s["study"]["rtols"] = Json{1e-6};
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
+  const Table t = read_table(dir_ / "wp" / "work_precision.csv");
+  ASSERT_EQ(t.rows.size(), 3u);
+  EXPECT_EQ(t.at(0, "method"), "auto");
+  EXPECT_EQ(t.at(1, "method"), "auto band 500 Hz");
+  EXPECT_EQ(t.at(2, "method"), "dirk fixed_step 0.0001 s");
+  EXPECT_EQ(t.at(2, "steps"), "200");  // 0.02 s
+  std::printf("fixed step 1e-4 s: error %s\n", t.at(2, "error").c_str());
+  EXPECT_LT(std::stod(t.at(2, "error")), 1e-4);
+  const double full = std::stod(t.at(0, "error")), band = std::stod(t.at(1, "error"));
+  std::printf("full model: error %.2e, %s steps; band 500 Hz: error %.2e, %s steps\n", full,
+              t.at(0, "steps").c_str(), band, t.at(1, "steps").c_str());
+  EXPECT_LT(full, 1e-6);
+  EXPECT_GT(band, 10 * full);  // the modes above 500 Hz, quasi-static, are what it leaves out
+  EXPECT_LT(band, 1e-3);
+  EXPECT_LT(std::stol(t.at(1, "steps")), std::stol(t.at(0, "steps")));
+}
+
+TEST_F(SpeedAccuracyRuns, WorkPrecisionRunsPastTheirBudgetAreTimeoutRows) {
+  Json s = small_work_precision();
+  s["study"]["max_seconds"] = 1e-6;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
+  const Table t = read_table(dir_ / "wp" / "work_precision.csv");
+  const Json summary = load_json(dir_ / "wp" / "summary.json");
+  ASSERT_EQ(t.rows.size(), 6u);
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    EXPECT_EQ(t.at(i, "status"), "timeout") << i;
+    EXPECT_EQ(t.at(i, "error"), "nan") << i;
+  }
+  EXPECT_EQ(summary["failed_or_timeout"], 6);
+  EXPECT_TRUE(summary["fastest_within_target"].is_null());
+}
+
+// "verify" measures a run against the same run at tolerances ten times tighter; the estimate must
+// agree with the error measured against a tight reference by the work-precision study.
+TEST_F(SpeedAccuracyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightReference) {
+  Json wp = small_work_precision();
+  wp["study"]["methods"] = Json::parse(R"([{"method": "dirk"}])");
+  wp["study"]["rtols"] = Json{1e-6};
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp"));
+  const double measured = std::stod(read_table(dir_ / "wp" / "work_precision.csv").at(0, "error"));
+
+  Json single = wp;
+  single.erase("study");
+  single["analyses"][0]["integrator"] =
+      Json{{"method", "dirk"}, {"rtol", 1e-6}, {"atol", 1e-6 * 1e-4}};
+  single["analyses"][0]["verify"] = true;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("single.json", single), "single"));
+  const Json summary = load_json(dir_ / "single" / "summary.json");
+  const Json& v = summary["analyses"][0]["verification"];
+  ASSERT_TRUE(v.is_object()) << summary.dump(2);
+  EXPECT_EQ(v["status"], "ok");
+  EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-7);
+  EXPECT_DOUBLE_EQ(v["atol"].get<double>(), 1e-11);
+  EXPECT_FALSE(v.contains("fixed_step"));
+  EXPECT_GT(v["steps"].get<long>(), summary["analyses"][0]["steps"].get<long>());
+  const double estimate = v["error"];
+  std::printf(
+      "dirk rtol 1e-6: error %.4g against rtol 1e-11, %.4g against rtol 1e-7 (ratio %.3f)\n",
+      measured, estimate, estimate / measured);
+  // If the tighter run's own error is at most a third of the run's, the estimate lies within
+  // [2/3, 4/3] of the true error.
+  EXPECT_GT(estimate / measured, 2.0 / 3.0);
+  EXPECT_LT(estimate / measured, 4.0 / 3.0);
+}
+
+// A fixed step sets its run's error whatever rtol: "verify" reruns it at half the step (a tighter
+// rtol alone would rerun the same steps and call the run exact).
+TEST_F(SpeedAccuracyRuns, VerifyHalvesAFixedStep) {
+  Json wp = small_work_precision();
+  wp["study"]["methods"] = Json::parse(R"([{"method": "dirk", "fixed_step": 4e-4}])");
+  wp["study"]["rtols"] = Json{1e-8};
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp"));
+  const double measured = std::stod(read_table(dir_ / "wp" / "work_precision.csv").at(0, "error"));
+
+  Json single = wp;
+  single.erase("study");
+  single["analyses"][0]["integrator"] =
+      Json{{"method", "dirk"}, {"fixed_step", 4e-4}, {"rtol", 1e-8}, {"atol", 1e-12}};
+  single["analyses"][0]["verify"] = true;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("single.json", single), "single"));
+  const Json summary = load_json(dir_ / "single" / "summary.json");
+  const Json& v = summary["analyses"][0]["verification"];
+  ASSERT_TRUE(v.is_object()) << summary.dump(2);
+  EXPECT_EQ(v["status"], "ok");
+  EXPECT_DOUBLE_EQ(v["fixed_step"].get<double>(), 2e-4);
+  EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-8);  // the Newton tolerance kept
+  EXPECT_EQ(summary["analyses"][0]["steps"], 50);   // 0.02 s
+  EXPECT_EQ(v["steps"], 100);
+  const double estimate = v["error"];
+  std::printf(
+      "dirk fixed step 4e-4 s: error %.4g against rtol 1e-11, %.4g against 2e-4 s "
+      "(ratio %.3f)\n",
+      measured, estimate, estimate / measured);
+  // At order 5 the rerun's own error is 1/32 of the run's: the estimate is within a few percent.
+  EXPECT_GT(estimate / measured, 0.9);
+  EXPECT_LT(estimate / measured, 1.1);
+}
+
+TEST_F(SpeedAccuracyRuns, ADesignPastItsBudgetIsATimeoutRowAndTheBatchGoesOn) {
+  Json s = load_json(kStudies / "work_precision_reference.json");
+  s["analyses"][0]["t_end"] = 0.01;
+  s["analyses"][0]["output_step"] = 0.01;
+  s["analyses"][0]["integrator"] = Json{{"rtol", 1e-8}, {"atol", 1e-10}};
+  s["responses"] = Json::parse(R"({"mass": {"quantity": "mass"}})");
+  s["study"] = Json::parse(R"({"type": "sweep", "sampling": "list", "max_seconds_per_design": 2.0,
+      "variables": [{"name": "t_end", "pointer": "/analyses/0/t_end"}],
+      "rows": [[0.01], [1000.0], [0.02]]})");
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("budget.json", s), "out", {"-j", "1"}));
+  const Table t = read_table(dir_ / "out" / "samples.csv");
+  ASSERT_EQ(t.rows.size(), 3u);
+  const std::vector<std::string> expected = {"ok", "timeout", "ok"};
+  for (size_t i = 0; i < 3; ++i) {
+    std::printf("t_end %s: %s in %s s %s\n", t.at(i, "t_end").c_str(), t.at(i, "status").c_str(),
+                t.at(i, "wall_s").c_str(), t.at(i, "message").c_str());
+    EXPECT_EQ(t.at(i, "status"), expected[i]) << i;
+  }
+  EXPECT_NE(t.at(1, "message").find("max_seconds"), std::string::npos) << t.at(1, "message");
+  EXPECT_GE(std::stod(t.at(1, "wall_s")), 2.0);
+}
+
+// Static and modal analyses honour the design's budget too: under a 0.2 s budget the
+// 20,000-segment loaded design is a timeout row (the static analysis is stopped; 5,000 segments
+// took 0.2 s, too close to the budget to tell), the unloaded 20,000-segment one too (the static
+// analysis has nothing to do, the modal one, ~0.5 s, is stopped; 5,000 segments take 0.16 s),
+// their neighbours ok. (Budgets once stopped transients only: 1.3-2.1 s static and modal designs
+// under 0.2 s were ok rows.)
+TEST_F(SpeedAccuracyRuns, StaticAndModalDesignsPastTheirBudgetAreTimeoutRows) {
+  Json s = load_json(kStudies / "bending_tip_load.json");
+  s["scene"]["beams"][0]["segments"] = 10;
+  s["analyses"] = Json::parse(R"([{"type": "static"}, {"type": "modal", "modes": 2}])");
+  s["responses"] = Json::parse(R"({"f1": {"quantity": "frequency", "mode": 1}})");
+  s["study"] = Json::parse(R"({"type": "sweep", "sampling": "list", "max_seconds_per_design": 0.05,
+      "variables": [{"name": "segments", "pointer": "/scene/beams/0/segments"},
+                    {"name": "load", "pointer": "/scene/loads/0/value/1"}],
+      "rows": [[10, -1], [20000, -1], [20000, 0], [20, 0]]})");
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("budget.json", s), "out", {"-j", "1"}));
+  const Table t = read_table(dir_ / "out" / "samples.csv");
+  ASSERT_EQ(t.rows.size(), 4u);
+  const std::vector<std::string> expected = {"ok", "timeout", "timeout", "ok"};
+  for (size_t i = 0; i < 4; ++i) {
+    std::printf("%s segments, load %s: %s in %s s, f1 %s %s\n", t.at(i, "segments").c_str(),
+                t.at(i, "load").c_str(), t.at(i, "status").c_str(), t.at(i, "wall_s").c_str(),
+                t.at(i, "f1").c_str(), t.at(i, "message").c_str());
+    EXPECT_EQ(t.at(i, "status"), expected[i]) << i;
+  }
+  EXPECT_NE(t.at(1, "message").find("static analysis"), std::string::npos);
+  EXPECT_NE(t.at(2, "message").find("modal analysis"), std::string::npos);
+  EXPECT_EQ(t.at(2, "f1"), "nan");
+}
+
+}  // namespace
+}  // namespace beamrail

@@ -296,8 +296,12 @@ TEST(TransientAuto, TheLanczosBandMeetsRtolAgainstAFixedStepImplicitRun) {
         "whose own error is below %.1e (the 10 us run's distance), %ld steps\n",
         bodies, rtol, run.result.phases[0].reason.c_str(), e, e / rtol, halving,
         run.result.stats.steps);
-    EXPECT_LT(halving, 0.1 * e);  // the reference is good enough to measure this run
-    EXPECT_LT(e, 10 * rtol);      // the window: [1e-3, 10] rtol
+    // The reference's own error is about halving / 1.8 (order 1.5 measured on 1,000 segments):
+    // this run's error is measured within 15 %.
+    EXPECT_LT(halving, 0.25 * e);
+    // Within the window, [1e-3, 10] rtol, and below 1.5 rtol (measured 0.54 and 0.71;
+    // 3.0 and 2.9 when the quasi-static iteration stopped at 1e-3 of the error weights).
+    EXPECT_LT(e, 1.5 * rtol);
     EXPECT_GT(e, 1e-3 * rtol);
   }
 }

@@ -32,12 +32,12 @@
 // (the horizon) moves less than those responses: there the size of a jump's or an initial
 // velocity's motion is its modes' linear response at 32 times up to the horizon (a 201-body
 // cantilever run for 10 ms, a twelfth of its period, chose bands that left 11 rtol of its own
-// motion; tests/core/analysis/transient_auto_test.cpp); a smooth load's is not reduced. The nonlinear forcing is not in it: the modal
-// method is for motions near its linearization. The band is the smallest number of modes (never
-// splitting a cluster of equal frequencies, never leaving out a rigid or mechanism mode) whose
-// estimate is at most the tolerance. An estimate, not a bound: on a cantilever
-// (tests/core/analysis/modal_band_test.cpp) the bands chosen for rtol 1e-3 .. 1e-6 made errors of
-// 0.42 .. 0.53 times it against the full model.
+// motion; tests/core/analysis/transient_auto_test.cpp); a smooth load's is not reduced. The
+// nonlinear forcing is not in it: the modal method is for motions near its linearization. The band
+// is the smallest number of modes (never splitting a cluster of equal frequencies, never leaving
+// out a rigid or mechanism mode) whose estimate is at most the tolerance. An estimate, not a bound:
+// on a cantilever (tests/core/analysis/modal_band_test.cpp) the bands chosen for rtol 1e-3 .. 1e-6
+// made errors of 0.42 .. 0.53 times it against the full model.
 #pragma once
 
 #include <Eigen/Dense>

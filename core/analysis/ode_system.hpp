@@ -46,10 +46,10 @@ struct OdeContext {
   // did so over failures of the right-hand side.
   std::string out_of_range;
   // The end of the current stretch between the loads' breakpoints or t_end (the transient
-  // analysis sets it): a jump there belongs to the next stretch, so the forces at or past it are those just
-  // before it. A step's last stage (c = 1) at the jump once saw the load on: dirk and erk moved
-  // before a step load at 10.05 ms (8 % of the motion off; the step before it held the whole
-  // load in its last stage and its interpolated outputs).
+  // analysis sets it): a jump there belongs to the next stretch, so the forces at or past it are
+  // those just before it. A step's last stage (c = 1) at the jump once saw the load on: dirk and
+  // erk moved before a step load at 10.05 ms (8 % of the motion off; the step before it held the
+  // whole load in its last stage and its interpolated outputs).
   double stretch_end = std::numeric_limits<double>::infinity();
 
   // The time the forces are evaluated at for the integrator's time t.

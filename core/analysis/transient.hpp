@@ -54,7 +54,7 @@ struct IntegratorOptions {
   // error is measured by halving the step (an undamped stiff scene makes an adaptive implicit
   // method resolve modes an L-stable fixed step damps). 0: adaptive steps.
   double fixed_step = 0.0;
-  long max_steps = 10000000;               // step budget of the whole run (all output steps)
+  long max_steps = 10000000;  // step budget of the whole run (all output steps)
   // modal: the configuration linearized about: "static" (the equilibrium under the loads at
   // t = 0), "initial" (the initial state), "" (static when that equilibrium is found within
   // kModalIntegratorMaxRotation of the initial state, else initial, with a warning).

@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-#include "tests/support/run_process.hpp"
+#include "tests/support/study_runs.hpp"
 
 #ifndef BEAMRAIL_EXECUTABLE
 #error "BEAMRAIL_EXECUTABLE must name the beamrail binary"
@@ -37,24 +37,13 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 using testing::Limits;
+using testing::lines_of;
+using testing::load_json;
 using testing::Process;
 using testing::ProcessResult;
 using testing::read_text;
 
 const fs::path kStudies = BEAMRAIL_STUDIES_DIR;
-
-Json load_json(const fs::path& path) { return Json::parse(read_text(path)); }
-
-// Lines without their newlines; *whole is false when the text does not end with one.
-std::vector<std::string> lines_of(const std::string& text, bool* whole = nullptr) {
-  std::vector<std::string> lines;
-  size_t start = 0;
-  for (size_t i = 0; i < text.size(); ++i)
-    if (text[i] == '\n') lines.push_back(text.substr(start, i - start)), start = i + 1;
-  if (start < text.size()) lines.push_back(text.substr(start));
-  if (whole) *whole = text.empty() || text.back() == '\n';
-  return lines;
-}
 
 size_t count_fields(const std::string& line) {
   size_t n = 1;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tests/support/study_runs.hpp"
@@ -28,7 +29,13 @@ using beamrail::testing::Table;
 
 const fs::path kStudies = BEAMRAIL_STUDIES_DIR;
 
-class SpeedAccuracyRuns : public testing::StudyRuns {};
+class SpeedAccuracyRuns : public testing::StudyRuns {
+ protected:
+  // The run of `method` at rtol (atol 1e-4 rtol) on small_work_precision(): its error against the
+  // study's tight reference, measured by a work-precision study, and the summary of the same run
+  // alone with "verify".
+  std::pair<double, Json> measure_and_verify(const Json& method, double rtol);
+};
 
 // The reference problem of studies/work_precision_reference.json cut to 3 segments and 0.02 s.
 Json small_work_precision() {
@@ -41,6 +48,23 @@ Json small_work_precision() {
   s["study"]["rtols"] = Json{1e-4, 1e-7};
   s["study"]["target_error"] = 1e-5;
   return s;
+}
+
+std::pair<double, Json> SpeedAccuracyRuns::measure_and_verify(const Json& method, double rtol) {
+  Json wp = small_work_precision();
+  wp["study"]["methods"] = Json::array({method});
+  wp["study"]["rtols"] = Json{rtol};
+  EXPECT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp"));
+  const double measured = std::stod(read_table(dir_ / "wp" / "work_precision.csv").at(0, "error"));
+  Json single = wp;
+  single.erase("study");
+  Json integrator = method;
+  integrator["rtol"] = rtol;
+  integrator["atol"] = rtol * 1e-4;
+  single["analyses"][0]["integrator"] = integrator;
+  single["analyses"][0]["verify"] = true;
+  EXPECT_NO_FATAL_FAILURE(run_ok(write_study("single.json", single), "single"));
+  return {measured, load_json(dir_ / "single" / "summary.json")};
 }
 
 TEST_F(SpeedAccuracyRuns, WorkPrecisionStudyTabulatesEveryMethodAndToleranceAgainstTheReference) {
@@ -120,19 +144,7 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionRunsPastTheirBudgetAreTimeoutRows) {
 // "verify" measures a run against the same run at tolerances ten times tighter; the estimate must
 // agree with the error measured against a tight reference by the work-precision study.
 TEST_F(SpeedAccuracyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightReference) {
-  Json wp = small_work_precision();
-  wp["study"]["methods"] = Json::parse(R"([{"method": "dirk"}])");
-  wp["study"]["rtols"] = Json{1e-6};
-  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp"));
-  const double measured = std::stod(read_table(dir_ / "wp" / "work_precision.csv").at(0, "error"));
-
-  Json single = wp;
-  single.erase("study");
-  single["analyses"][0]["integrator"] =
-      Json{{"method", "dirk"}, {"rtol", 1e-6}, {"atol", 1e-6 * 1e-4}};
-  single["analyses"][0]["verify"] = true;
-  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("single.json", single), "single"));
-  const Json summary = load_json(dir_ / "single" / "summary.json");
+  const auto [measured, summary] = measure_and_verify(Json{{"method", "dirk"}}, 1e-6);
   const Json& v = summary["analyses"][0]["verification"];
   ASSERT_TRUE(v.is_object()) << summary.dump(2);
   EXPECT_EQ(v["status"], "ok");
@@ -153,19 +165,8 @@ TEST_F(SpeedAccuracyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightRefe
 // A fixed step sets its run's error whatever rtol: "verify" reruns it at half the step (a tighter
 // rtol alone would rerun the same steps and call the run exact).
 TEST_F(SpeedAccuracyRuns, VerifyHalvesAFixedStep) {
-  Json wp = small_work_precision();
-  wp["study"]["methods"] = Json::parse(R"([{"method": "dirk", "fixed_step": 4e-4}])");
-  wp["study"]["rtols"] = Json{1e-8};
-  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp"));
-  const double measured = std::stod(read_table(dir_ / "wp" / "work_precision.csv").at(0, "error"));
-
-  Json single = wp;
-  single.erase("study");
-  single["analyses"][0]["integrator"] =
-      Json{{"method", "dirk"}, {"fixed_step", 4e-4}, {"rtol", 1e-8}, {"atol", 1e-12}};
-  single["analyses"][0]["verify"] = true;
-  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("single.json", single), "single"));
-  const Json summary = load_json(dir_ / "single" / "summary.json");
+  const auto [measured, summary] =
+      measure_and_verify(Json{{"method", "dirk"}, {"fixed_step", 4e-4}}, 1e-8);
   const Json& v = summary["analyses"][0]["verification"];
   ASSERT_TRUE(v.is_object()) << summary.dump(2);
   EXPECT_EQ(v["status"], "ok");

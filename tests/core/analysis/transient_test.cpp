@@ -169,6 +169,19 @@ TEST(Transient, DampingNeverIncreasesTotalEnergy) {
   EXPECT_GT(lost, 0.1);  // the damping does act
 }
 
+// A 1 kg tip on a 1 m steel cantilever of 10 mm square section, pulled down by 1 N times the
+// time function `time` (JSON).
+Model loaded_tip(const std::string& time) {
+  return testing::scene_from_json(R"({
+      "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+      "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+      "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-4, 1e-4, 1e-4], "position": [1, 0, 0]}],
+      "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+                 "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq"}],
+      "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0], "time": )" +
+                                  time + "}]}");
+}
+
 // A load's breakpoint within rounding of an output time: a table knot at 0.011 s with outputs
 // every 1e-4 s (the 110th at 0.011000000000000001). Every method once failed there, asked for a
 // step of 1.7e-18 s ("tout too close to t0", "the step size fell below the roundoff of the
@@ -178,15 +191,8 @@ TEST(Transient, ABreakpointWithinRoundingOfAnOutputTimeIsThatTime) {
   const auto scene = [](double knot) {
     char text[32];
     std::snprintf(text, sizeof text, "%.17g", knot);
-    return testing::scene_from_json(R"({
-      "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
-      "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-      "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-4, 1e-4, 1e-4], "position": [1, 0, 0]}],
-      "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-                 "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq"}],
-      "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0],
-                 "time": {"type": "table", "t": [0.001, )" +
-                                    std::string(text) + R"(], "v": [0, 1]}}]})");
+    return loaded_tip(R"({"type": "table", "t": [0.001, )" + std::string(text) +
+                      R"(], "v": [0, 1]})");
   };
   const double on_output = 110 * 1e-4;
   ASSERT_NE(on_output, 0.011);
@@ -213,15 +219,7 @@ TEST(Transient, ABreakpointWithinRoundingOfAnOutputTimeIsThatTime) {
 // until the jump and then match the same load stepped on at t = 0, shifted by the jump's time.
 TEST(Transient, AStepLoadActsFromItsTimeOnInEveryMethod) {
   const auto scene = [](const std::string& at) {
-    return testing::scene_from_json(R"({
-      "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
-      "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-      "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-4, 1e-4, 1e-4], "position": [1, 0, 0]}],
-      "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-                 "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq"}],
-      "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0],
-                 "time": {"type": "step", "at": )" +
-                                    at + "}}]}");
+    return loaded_tip(R"({"type": "step", "at": )" + at + "}");
   };
   const Model late = scene("0.01005"), early = scene("0");
   const int shift = 201;  // 0.01005 / 5e-5 output steps

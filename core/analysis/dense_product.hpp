@@ -1,4 +1,4 @@
-// Products of a dense matrix with one or two vectors: the modal integrator's changes of basis, ten
+// Products of a dense matrix with one, two or six vectors: the modal integrator's changes of basis, ten
 // to twenty per step on matrices up to 1200 x 1200 (every mode) or n x m (a band of m modes of n
 // degrees of freedom, 6000 x 95 and more).
 //
@@ -16,6 +16,10 @@ namespace beamrail {
 // y = a x for the column-major arrays x (a.cols() x 2) and y (a.rows() x 2): two vectors side by
 // side.
 void multiply_pair(const Eigen::MatrixXd& a, const double* x, double* y);
+
+// y = a x for x (a.cols() x 6) and y (a.rows() x 6), column-major: three pairs in one pass (a
+// trial step's new state and its two error estimates).
+void multiply_three_pairs(const Eigen::MatrixXd& a, const double* x, double* y);
 
 // y = a x for the vectors x (length a.cols()) and y (length a.rows()).
 void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y);

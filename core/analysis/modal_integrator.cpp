@@ -471,11 +471,9 @@ class ModalExponential : public Integrator {
     return true;
   }
 
-  // Weighted RMS norm of a modal error dz, measured in the physical states (x: rtol |c| + atol
-  // for positions, rtol + atol for rotations; u: rtol |u| + atol) at the physical state x.
-  double error_norm(const Block& dz, const Block& x) {
-    multiply(phi_, dz, e_);
-    const Block& e = e_;
+  // Weighted RMS norm of an error e = Phi dz in the physical states (x: rtol |c| + atol for
+  // positions, rtol + atol for rotations; u: rtol |u| + atol) at the physical state x.
+  double error_norm(const Eigen::Ref<const Block>& e, const Block& x) {
     double sum = 0.0;
     for (size_t b = 0; b < c0_.size(); ++b)
       for (int j = 0; j < kD; ++j) {
@@ -549,21 +547,28 @@ class ModalExponential : public Integrator {
         const bool ok = step(full_, t_, z_, n0, next, &sflag);
         double err = 0.0;
         if (ok) {
-          multiply(phi_, next, x_next_);
           // The distance to the embedded third-order solution, h b5 (N5 - N3), and to the
           // embedded second-order one from stages 1 and 2 against rtol^(3/4) (both then ask for
-          // steps ~ rtol^(1/4)).
+          // steps ~ rtol^(1/4)); the new state and both distances go to physical states in one
+          // pass over Phi.
+          trial_.resize(m_, 6);
+          trial_.leftCols<2>() = next;
           Block& difference = difference_;
           difference.setZero(m_, 2);
           apply_add(full_.b[4], lambda_, stage_n_[4], difference, h);
           apply_add(full_.b[4], lambda_, stage_n_[2], difference, -h);
-          err = error_norm(difference, x_next_) / kToleranceScale;
+          trial_.middleCols<2>(2) = difference;
           // next - low, low the embedded second-order solution.
           difference = next;
           apply_add(full_.e_full, lambda_, z_, difference, -1.0);
           apply_add(full_.low[0], lambda_, stage_n_[0], difference, -h);
           apply_add(full_.low[1], lambda_, stage_n_[1], difference, -h);
-          err = std::max(err, error_norm(difference, x_next_) * low_order_weight_);
+          trial_.rightCols<2>() = difference;
+          trial_x_.resize(n_, 6);
+          multiply_three_pairs(phi_, trial_.data(), trial_x_.data());
+          x_next_ = trial_x_.leftCols<2>();
+          err = std::max(error_norm(trial_x_.middleCols<2>(2), x_next_) / kToleranceScale,
+                         error_norm(trial_x_.rightCols<2>(), x_next_) * low_order_weight_);
           if (!std::isfinite(err)) err = 1e10;
         } else if (sflag == kNonFinite) {
           // Perhaps a trial state too far out: retry smaller before giving up.
@@ -639,7 +644,9 @@ class ModalExponential : public Integrator {
   std::vector<Vec4> q0_;
   std::vector<Mat3> a0_;
   Block z_, x_;            // the accepted state, modal and physical (x_ = Phi z_)
-  Block xi_, x_next_, e_;  // work space: a stage's physical state, a trial step's, its error
+  Block xi_, x_next_;  // work space: a stage's physical state, a trial step's
+  // A trial step's new state and its two error estimates side by side, modal and physical.
+  Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
   Block stage_z_, next_, difference_;  // work space: a stage's modal state, a trial step, errors
   Eigen::VectorXd y_start_;            // work space: the quasi-static part at the accepted state
   std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote

@@ -83,8 +83,8 @@ class ModalExponential : public Integrator {
     // The linearization: mass and symmetric tangent stiffness at the reference, at rest.
     Data& data = c.data;
     set_state(model, data, reference.data());
-    compute_wrenches(model, data, t0);
-    compute_tangent(model, data, t0, false);
+    compute_wrenches(model, data, c.force_time(t0));
+    compute_tangent(model, data, c.force_time(t0), false);
     c0_.resize(model.n_free());
     a0_.resize(model.n_free());
     q0_.resize(model.n_free());

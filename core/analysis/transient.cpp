@@ -204,6 +204,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
         if (at_break && stop - t <= same_time) {  // there already
           ++next_break;
           normalize_quaternions(model, y.data());
+          context.stretch_start = stop;
           integrator->restart(t, y);
           continue;
         }
@@ -221,6 +222,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
         if (at_break && t >= stop) {
           ++next_break;
           normalize_quaternions(model, y.data());
+          context.stretch_start = stop;
           integrator->restart(t, y);
         }
       }

@@ -1,8 +1,11 @@
 #include "core/analysis/modal_band.hpp"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 
 #include "core/analysis/modal_analysis.hpp"
@@ -18,38 +21,39 @@ bool same_function(const TimeFunction& a, const TimeFunction& b) {
          a.frequency == b.frequency && a.phase == b.phase && a.t == b.t && a.v == b.v;
 }
 
-// How a load's time function changes after t0: false when it does not; else *rate (0 for a
-// jump) and *factor (its largest value).
-bool change_after(const TimeFunction& f, double t0, double* rate, double* factor) {
+// How a load's time function changes after t0 and before t1: false when it does not; else *rate
+// (0 for a jump) and *factor (its largest value). A jump at t1 (the run's end) acts after it.
+bool change_after(const TimeFunction& f, double t0, double t1, double* rate, double* factor) {
   *factor = 1.0;
   switch (f.type) {
     case TimeFunction::Type::kConstant:
       return false;
     case TimeFunction::Type::kStep:
       *rate = 0.0;
-      return f.at > t0;  // a step at t0 is in the force out of balance there
+      return f.at > t0 && f.at < t1;  // a step at t0 is in the force out of balance there
     case TimeFunction::Type::kRamp: {
-      if (f.to <= t0) return false;
-      const double kinks = f.from >= t0 ? 2.0 : 1.0;
+      if (f.to <= t0 || f.from >= t1) return false;
+      // Its kinks within the run (at least one: a run that starts on the ramp starts at rest).
+      const double kinks = std::max(1.0, (f.from >= t0 ? 1.0 : 0.0) + (f.to < t1 ? 1.0 : 0.0));
       *rate = f.to > f.from ? kinks / (f.to - f.from) : 0.0;
       return true;
     }
     case TimeFunction::Type::kSmoothRamp:  // one cycle of a cosine in its acceleration
-      if (f.to <= t0) return false;
+      if (f.to <= t0 || f.from >= t1) return false;
       *rate = 2.0 * std::numbers::pi / (f.to - f.from);
       return true;
     case TimeFunction::Type::kHarmonic:
       *rate = 2.0 * std::numbers::pi * std::abs(f.frequency);
       return f.frequency != 0.0;
     case TimeFunction::Type::kTable: {
-      // Slope changes at the knots after t0 (held outside: slope 0 before and after).
+      // Slope changes at the knots in [t0, t1) (held outside: slope 0 before and after).
       double kinks = 0.0, previous = 0.0;
       *factor = 0.0;
       for (size_t k = 0; k < f.t.size(); ++k) {
         const double slope =
             k + 1 < f.t.size() ? (f.v[k + 1] - f.v[k]) / (f.t[k + 1] - f.t[k]) : 0.0;
         // The knots from t0 on, and the slope of the segment t0 lies in (the run starts on it).
-        if (f.t[k] >= t0 || (k + 1 < f.t.size() && f.t[k + 1] > t0))
+        if (f.t[k] < t1 && (f.t[k] >= t0 || (k + 1 < f.t.size() && f.t[k + 1] > t0)))
           kinks += f.t[k] >= t0 ? std::abs(slope - previous) : std::abs(slope);
         previous = slope;
         *factor = std::max(*factor, std::abs(f.v[k]));
@@ -60,6 +64,75 @@ bool change_after(const TimeFunction& f, double t0, double* rate, double* factor
     }
   }
   return false;
+}
+
+// A load factor's changes over [0, horizon] after t0 (times from t0): its jumps and the linear
+// pieces of the rest (exact for ramps and tables; a smooth ramp or a harmonic factor in at least
+// 64 pieces, 16 per period).
+struct FactorChanges {
+  std::vector<std::pair<double, double>> jumps;      // (time, size)
+  std::vector<std::array<double, 3>> pieces;         // (from, to, slope)
+  double start = 0.0;                                // the first change
+};
+
+FactorChanges factor_changes(const BandExcitation& e, double horizon) {
+  FactorChanges c;
+  const TimeFunction* f = e.time;
+  if (!f) {
+    c.jumps.push_back({0.0, 1.0});
+    return c;
+  }
+  if (f->type == TimeFunction::Type::kStep) {
+    if (f->at > e.t0 && f->at < e.t0 + horizon) c.jumps.push_back({f->at - e.t0, 1.0});
+    c.start = c.jumps.empty() ? horizon : c.jumps.front().first;
+    return c;
+  }
+  std::vector<double> knots, times = {0.0, horizon};
+  f->append_breakpoints(knots);
+  if (f->type == TimeFunction::Type::kSmoothRamp) knots.insert(knots.end(), {f->from, f->to});
+  for (double k : knots)
+    if (k > e.t0 && k < e.t0 + horizon) times.push_back(k - e.t0);
+  const int pieces =
+      f->type == TimeFunction::Type::kHarmonic
+          ? static_cast<int>(std::clamp(16.0 * std::abs(f->frequency) * horizon, 64.0, 1024.0))
+          : 64;
+  for (int i = 1; i < pieces; ++i) times.push_back(horizon * i / pieces);
+  std::sort(times.begin(), times.end());
+  c.start = horizon;
+  for (size_t i = 0; i + 1 < times.size(); ++i) {
+    const double a = times[i], b = times[i + 1];
+    if (!(b > a)) continue;
+    const double slope = ((*f)(e.t0 + b) - (*f)(e.t0 + a)) / (b - a);
+    if (slope == 0.0) continue;
+    c.pieces.push_back({a, b, slope});
+    c.start = std::min(c.start, a);
+  }
+  return c;
+}
+
+// The factor's change from t0 to t0 + tau, and the response then of an undamped mode of angular
+// frequency w at rest at t0 whose static response to a unit factor is 1.
+double factor_change(const FactorChanges& c, double tau) {
+  double x = 0.0;
+  for (const auto& [time, size] : c.jumps)
+    if (tau >= time) x += size;
+  for (const auto& [a, b, slope] : c.pieces)
+    if (tau > a) x += slope * (std::min(tau, b) - a);
+  return x;
+}
+
+double mode_response(const FactorChanges& c, double w, double tau) {
+  double x = 0.0;
+  for (const auto& [time, size] : c.jumps)
+    if (tau >= time) x += size * (1.0 - std::cos(w * (tau - time)));
+  for (const auto& [a, b, slope] : c.pieces) {
+    if (tau <= a) continue;
+    if (tau <= b)
+      x += slope * ((tau - a) - std::sin(w * (tau - a)) / w);
+    else
+      x += slope * ((b - a) - (std::sin(w * (tau - a)) - std::sin(w * (tau - b))) / w);
+  }
+  return x;
 }
 
 }  // namespace
@@ -142,28 +215,44 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
         break;
     }
     const double size = e.kind == BandExcitation::Kind::kVelocity ? 1.0 / w(0) : 1.0;
-    // Within a quarter of the lowest elastic period a jump or a velocity has not moved that far
-    // yet: its modes' linear response up to the horizon (the modes beyond those given respond
-    // at once: their static part counts in full for a jump).
-    const bool early = horizon > 0.0 && lowest_positive > 0.0 && (e.rate == 0.0) &&
-                       horizon * std::sqrt(lowest_positive) < 0.5 * std::numbers::pi;
+    // Within a quarter of the lowest elastic period of its first change a load has not moved
+    // that far yet (nor has an initial velocity): its modes' linear response up to the horizon,
+    // through the load's own time function (a jump, a ramp, a table ...; the modes beyond those
+    // given respond quasi-statically). A jump late in a run once counted as if it acted from
+    // the start (a step at 9 ms of a 10 ms run took 22 modes and left 11 rtol), a load that acts
+    // only after the run at its full static response (166 rtol).
+    const bool force = e.kind == BandExcitation::Kind::kForce;
+    const FactorChanges changes = force ? factor_changes(e, horizon) : FactorChanges{};
+    const bool early = horizon > 0.0 && lowest_positive > 0.0 &&
+                       (horizon - changes.start) * std::sqrt(lowest_positive) <
+                           0.5 * std::numbers::pi;
+    Eigen::MatrixXd response;  // per mode (from `rigid`) and sample time: g_k(tau_j)
+    Eigen::VectorXd change;    // the factor's change at the sample times
+    if (early) {
+      response.resize(total, kHorizonSamples);
+      change.resize(kHorizonSamples);
+      for (int j = 0; j < kHorizonSamples; ++j) {
+        const double tau = changes.start + (horizon - changes.start) * (j + 1) / kHorizonSamples;
+        change(j) = force ? factor_change(changes, tau) : 0.0;
+        for (Eigen::Index k = rigid; k < total; ++k)
+          response(k, j) = force ? mode_response(changes, w(k), tau) : std::sin(w(k) * tau) / w(k);
+      }
+    }
     for (int part = 0; part < 2; ++part) {
       const std::vector<Eigen::Index> rows = rows_of(part);
       double reached = 0.0;
       if (early) {
         Eigen::VectorXd beyond = elastic;  // the response of the modes beyond those given
         for (Eigen::Index k = rigid; k < total; ++k) beyond -= t.coefficients(k) * phi.col(k);
-        const bool jump = e.kind == BandExcitation::Kind::kForce;
-        for (int j = 1; j <= kHorizonSamples; ++j) {
-          const double time = horizon * j / kHorizonSamples;
+        // Per unit factor: a table's coefficients carry its largest value.
+        const double unit = force ? 1.0 / e.factor : 1.0;
+        for (int j = 0; j < kHorizonSamples; ++j)
           for (Eigen::Index r : rows) {
-            double x = jump ? beyond(r) : 0.0;
+            double x = force ? beyond(r) * change(j) : 0.0;
             for (Eigen::Index k = rigid; k < total; ++k)
-              x += t.coefficients(k) * phi(r, k) *
-                   (jump ? 1.0 - std::cos(w(k) * time) : std::sin(w(k) * time) / w(k));
-            reached = std::max(reached, std::abs(x));
+              x += t.coefficients(k) * phi(r, k) * response(k, j);
+            reached = std::max(reached, unit * std::abs(x));
           }
-        }
       }
       for (Eigen::Index r : rows) {
         const double full = size * std::abs(elastic(r));
@@ -249,7 +338,9 @@ std::vector<int> watched_bodies(const Model& model) {
 
 std::vector<BandExcitation> band_excitations(const Model& model, const Data& data,
                                              const Eigen::VectorXd& unbalanced,
-                                             const Eigen::VectorXd& velocity, double t0) {
+                                             const Eigen::VectorXd& velocity, double t0,
+                                             double horizon) {
+  const double t1 = horizon > 0.0 ? t0 + horizon : std::numeric_limits<double>::infinity();
   std::vector<BandExcitation> out;
   if (unbalanced.size() == model.n_dofs && unbalanced.cwiseAbs().maxCoeff() > 0.0)
     out.push_back({BandExcitation::Kind::kForce, unbalanced, 0.0, 1.0});
@@ -262,13 +353,13 @@ std::vector<BandExcitation> band_excitations(const Model& model, const Data& dat
   for (const Load& load : model.loads) {
     const int k = free_index[load.body];
     double rate = 0.0, factor = 1.0;
-    if (k < 0 || !change_after(load.time, t0, &rate, &factor)) continue;
+    if (k < 0 || !change_after(load.time, t0, t1, &rate, &factor)) continue;
     size_t slot = 0;
     while (slot < out.size() && !(functions[slot] && same_function(*functions[slot], load.time)))
       ++slot;
     if (slot == out.size()) {
       out.push_back({BandExcitation::Kind::kForce, Eigen::VectorXd::Zero(model.n_dofs), rate,
-                     factor, load.time.type == TimeFunction::Type::kHarmonic});
+                     factor, load.time.type == TimeFunction::Type::kHarmonic, &load.time, t0});
       functions.push_back(&load.time);
     }
     const Pose<double>& pose = data.pose[load.body];

@@ -62,6 +62,10 @@ struct BandExcitation {
   double rate = 0.0;       // kForce: 0 for a jump, else how fast it changes [rad/s]
   double factor = 1.0;     // kForce: the load's largest time factor (a table's largest value)
   bool harmonic = false;   // kForce: a harmonic load (rate its angular frequency)
+  // kForce: how the load's factor changes from t0 on (absolute times); none: a jump at t0 (the
+  // force out of balance at the start). choose_band follows it over a short run's horizon.
+  const TimeFunction* time = nullptr;
+  double t0 = 0.0;
 };
 
 // Modes below this times a harmonic load's angular frequency are always kept: quasi-static, they
@@ -91,11 +95,12 @@ std::vector<int> watched_bodies(const Model& model);
 
 // The excitations of a run from t0 on: the force out of balance at the initial state and its
 // velocity (per degree of freedom, empty or zero when none) and every load whose value changes
-// after t0 (steps after t0, ramps, harmonic loads, tables), its generalized force at the pose of
-// `data` (the linearization).
+// after t0 and before t0 + horizon (0: unbounded) (steps, ramps, harmonic loads, tables), its
+// generalized force at the pose of `data` (the linearization).
 std::vector<BandExcitation> band_excitations(const Model& model, const Data& data,
                                              const Eigen::VectorXd& unbalanced,
-                                             const Eigen::VectorXd& velocity, double t0);
+                                             const Eigen::VectorXd& velocity, double t0,
+                                             double horizon = 0.0);
 
 // The modes of a band-limited run (core/analysis/modal_integrator.hpp): from the dense eigensolver
 // up to kModalIntegratorMaxDofs degrees of freedom, else from shift-invert Lanczos asked for more

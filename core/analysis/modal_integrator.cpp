@@ -223,7 +223,8 @@ class ModalExponential : public Integrator {
       if (!accelerations(t0, x))
         return fail(error, "the modal integrator: the forces at the initial state are not finite");
       data = linearized;
-      excitations = band_excitations(model, data, m0_ * acceleration_, velocity, t0);
+      excitations = band_excitations(model, data, m0_ * acceleration_, velocity, t0,
+                                     options_.horizon > t0 ? options_.horizon - t0 : 0.0);
     }
     const double seconds =
         std::chrono::duration<double>(context_->deadline - std::chrono::steady_clock::now())

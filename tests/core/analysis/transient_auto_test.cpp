@@ -338,5 +338,65 @@ TEST(TransientBand, ErrorShrinksAsTheBandWidens) {
   EXPECT_LT(run_error(model, all, full), 1e-9);
 }
 
+// A band chosen for rtol (max_frequency_hz "auto") over a run shorter than a quarter of the
+// lowest period: what a load reaches by the end depends on when and how it acts. Each case on the
+// reference cantilever in 40 segments against the full modal method at rtol 1e-10. Before (each
+// case here), a step at 9 ms of a 10 ms run counted as if it acted from the start (27 modes, 15
+// rtol), a load acting only after the run at its full static response (2 modes, 5e4 rtol), and
+// ramps and a harmonic load over 1 ms at their static response (15 modes, 41 .. 122 rtol).
+TEST(TransientBand, AChosenBandFollowsWhatTheLoadsDoWithinTheRun) {
+  const std::string step = R"("time": {"type": "step", "at": 0.0})";
+  struct Case {
+    const char* label;
+    const char* time;   // the tip load's time function
+    const char* extra;  // another load, or ""
+    double t_end, output_step, rtol;
+  } cases[] = {
+      {"step at 9 ms of 10 ms", R"("time": {"type": "step", "at": 0.009})", "", 0.01, 1e-4, 1e-4},
+      {"step at 0 of 1 ms (the same motion)", R"("time": {"type": "step", "at": 0.0})", "", 1e-3,
+       1e-5, 1e-4},
+      {"ramp over 0.2 ms of 1 ms", R"("time": {"type": "ramp", "from": 0.0, "to": 2e-4})", "",
+       1e-3, 1e-5, 1e-4},
+      {"smooth ramp over 0.2 ms of 1 ms",
+       R"("time": {"type": "smooth_ramp", "from": 0.0, "to": 2e-4})", "", 1e-3, 1e-5, 1e-4},
+      {"300 Hz harmonic over 1 ms", R"("time": {"type": "harmonic", "frequency": 300})", "", 1e-3,
+       1e-5, 1e-4},
+      {"step at 0 and a 1 kN ramp from 10 s, over 1 ms", R"("time": {"type": "step", "at": 0.0})",
+       R"(, {"type": "force", "body": "tip", "value": [0, 0, -1000],
+             "time": {"type": "ramp", "from": 10, "to": 20}})",
+       1e-3, 1e-5, 1e-4}};
+  int modes_step_at_0 = 0;
+  for (const Case& c : cases) {
+    std::string json = reference_cantilever(40);
+    json.replace(json.find(step), step.size(), c.time);
+    json.replace(json.rfind("]}"), 2, std::string(c.extra) + "]}");
+    const Model model = scene_from_json(json);
+    TransientOptions o = options(c.t_end, c.output_step, 1e-10, 1e-14);
+    o.integrator.method = IntegratorMethod::kModal;
+    const TransientRun reference = simulate(model, o);
+    ASSERT_TRUE(reference.result.ok) << c.label << ": " << reference.result.message;
+    o.integrator.rtol = c.rtol;
+    o.integrator.atol = 1e-2 * c.rtol;
+    o.integrator.choose_band = true;
+    const TransientRun run = simulate(model, o);
+    ASSERT_TRUE(run.result.ok) << c.label << ": " << run.result.message;
+    ASSERT_EQ(run.result.phases.size(), 1u);
+    const std::string& why = run.result.phases[0].reason;
+    int modes = 0;
+    const size_t at = why.find("chosen for rtol: ");
+    ASSERT_NE(at, std::string::npos) << why;
+    ASSERT_EQ(std::sscanf(why.c_str() + at, "chosen for rtol: %d", &modes), 1) << why;
+    const double e = run_error(model, run, reference);
+    std::printf("%s, rtol %.0e: %d modes, error %.2e (%.2f rtol), %.2f s (reference %.2f s)\n",
+                c.label, c.rtol, modes, e, e / c.rtol, run.result.stats.wall_seconds,
+                reference.result.stats.wall_seconds);
+    EXPECT_LT(e, 1.5 * c.rtol) << c.label;
+    if (std::string(c.label).starts_with("step at 0 of")) modes_step_at_0 = modes;
+    if (*c.extra) {
+      EXPECT_EQ(modes, modes_step_at_0);  // a load acting after the run is not counted
+    }
+  }
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/analysis/explicit_stability.hpp"
 #include "core/analysis/modal_integrator.hpp"
 #include "core/model/element_kinds.hpp"
 
@@ -26,15 +27,6 @@ SolverStats sum(const SolverStats& a, const SolverStats& b) {
   s.nonlinear_failures += b.nonlinear_failures;
   s.error_test_failures += b.error_test_failures;
   return s;
-}
-
-// The largest stiffness-proportional damping of the scene's elements [s].
-double largest_damping(const Model& model) {
-  double beta = 0.0;
-  for_each_element(model, [&beta](auto kind, const auto& e, int) {
-    beta = std::max(beta, decltype(kind)::damping(e));
-  });
-  return beta;
 }
 
 // The quoted name in a message ("body \"tip\" turned ..."), or "".

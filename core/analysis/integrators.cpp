@@ -11,10 +11,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 
 #include "core/analysis/auto_integrator.hpp"
+#include "core/analysis/explicit_stability.hpp"
 #include "core/analysis/klu_solver.hpp"
 #include "core/analysis/modal_integrator.hpp"
 
@@ -138,9 +140,11 @@ class SundialsIntegrator : public Integrator {
     std::string why = explain(flag, package_, flag < 0 && flag != kNonFiniteState ? name(flag) : "",
                               messages_.last, *context_, max_steps_);
     if (fixed_step_ && !context_->interrupted && !context_->timed_out)
-      why +=
-          "; with fixed_step the step cannot shrink: try a shorter fixed_step, or a looser rtol "
-          "(the Newton tolerance)";
+      why += flag == -1  // *_TOO_MUCH_WORK
+                 ? "; with fixed_step every step is taken: a longer fixed_step or a larger "
+                   "max_steps"
+                 : "; with fixed_step the step cannot shrink: try a shorter fixed_step, or a "
+                   "looser rtol (the Newton tolerance)";
     return why;
   }
 
@@ -356,6 +360,25 @@ class ArkodeExplicit : public SundialsIntegrator {
         return fail(error, "ARKODE refused fixed_step: " + messages_.last);
       warnings.push_back(kFixedStepWarning);
       fixed_step_ = true;
+      // Nothing would notice modes that grow without bound: refused before the run.
+      const FixedStepStability s = fixed_step_stability(
+          c.model, c.data, N_VGetArrayPointer(y0), 0.0, table, o.fixed_step,
+          o.horizon > 0.0 ? o.horizon : o.fixed_step);
+      if (!s.checked) {
+        warnings.push_back(
+            "fixed_step: the scene's fastest mode could not be computed; the explicit table's "
+            "stability at this step is not checked");
+      } else if (s.growth > kFixedStepMaxGrowth) {
+        char text[400];
+        std::snprintf(text, sizeof text,
+                      "fixed_step %g s is beyond the stability of the explicit table %s: the "
+                      "scene's fastest mode (%.4g rad/s at the start) would grow by a factor of "
+                      "%.3g over the run; a fixed step of at most %.3g s keeps it within %g, or "
+                      "use dirk",
+                      o.fixed_step, table.c_str(), s.fastest, s.growth, s.stable_step,
+                      kFixedStepMaxGrowth);
+        return fail(error, text);
+      }
     }
     return true;
   }

@@ -134,7 +134,19 @@ bool TransientOptions::IsValid(std::string* error) const {
   if (t_end / output_step > 1e8) return refuse(error, "more than 1e8 output rows requested");
   if (!zero_or_positive_finite(max_seconds))
     return refuse(error, "max_seconds must be 0 (no budget) or positive and finite");
-  return integrator.IsValid(error);
+  if (!integrator.IsValid(error)) return false;
+  // A fixed step longer than the run is one step with no error estimate; one so short that the
+  // run would take more than max_steps steps fails only after all of them (1e-300 s: minutes).
+  const double h = integrator.fixed_step;
+  if (h > t_end) return refuse(error, "fixed_step must not exceed t_end");
+  if (h > 0.0 && t_end / h > static_cast<double>(integrator.max_steps)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "fixed_step %g s takes %.3g steps over t_end, more than max_steps (%ld)", h,
+                  t_end / h, integrator.max_steps);
+    return refuse(error, text);
+  }
+  return true;
 }
 
 TransientResult run_transient(const Model& model, const TransientOptions& options, Data& data,

@@ -330,6 +330,23 @@ TEST_F(BadInput, FixedStepWithAStepLimit) {
   }
 }
 
+// A fixed step longer than the run, or so short that the run would take more than max_steps
+// steps (1e-300 s once ran for minutes before failing with "try a shorter fixed_step").
+TEST_F(BadInput, FixedStepAgainstTheRun) {
+  const struct {
+    double step;
+    const char* message;
+  } cases[] = {{0.02, "fixed_step must not exceed t_end"},
+               {1e-300, "fixed_step 1e-300 s takes 1e+298 steps over t_end, more than max_steps "
+                        "(10000000)"}};
+  for (const auto& c : cases) {
+    Json study = base();  // t_end 0.01
+    study["analyses"][0]["integrator"]["method"] = "erk";
+    study["analyses"][0]["integrator"]["fixed_step"] = c.step;
+    EXPECT_TRUE(HasOnlyError(check(study), "bad.json:/analyses/0/integrator:", c.message));
+  }
+}
+
 // A transient's band: a frequency > 0, "output" or "auto", and only for the methods that have
 // one; the integrator's: a frequency or "auto".
 TEST_F(BadInput, TransientBand) {

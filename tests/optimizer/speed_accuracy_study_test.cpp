@@ -106,14 +106,17 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionShowsWhatABandOrAFixedStepCosts) {
   s["scene"]["beams"][0]["segments"] = 10;
   s["study"]["methods"] =
       Json::parse(R"([{"method": "auto"}, {"method": "auto", "max_frequency_hz": 500},
-                                          {"method": "dirk", "fixed_step": 1e-4}])");
+                                          {"method": "dirk", "fixed_step": 1e-4},
+                                          {"method": "dirk", "fixed_step": 1.0000001e-4}])");
   s["study"]["rtols"] = Json{1e-6};
   ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
   const Table t = read_table(dir_ / "wp" / "work_precision.csv");
-  ASSERT_EQ(t.rows.size(), 3u);
+  ASSERT_EQ(t.rows.size(), 4u);
   EXPECT_EQ(t.at(0, "method"), "auto");
   EXPECT_EQ(t.at(1, "method"), "auto band 500 Hz");
   EXPECT_EQ(t.at(2, "method"), "dirk fixed_step 0.0001 s");
+  // Two steps that %g's six digits made one label.
+  EXPECT_EQ(t.at(3, "method"), "dirk fixed_step 0.00010000001 s");
   EXPECT_EQ(t.at(2, "steps"), "200");  // 0.02 s
   std::printf("fixed step 1e-4 s: error %s\n", t.at(2, "error").c_str());
   EXPECT_LT(std::stod(t.at(2, "error")), 1e-4);

@@ -60,8 +60,7 @@ template <int kVectors, bool kSquare>
 // passes of product_kernel 502 us.
 template <int kVectors>
 [[gnu::always_inline]] inline void wide_kernel(long rows, long cols, const double* __restrict a,
-                                               const double* __restrict x,
-                                               double* __restrict y) {
+                                               const double* __restrict x, double* __restrict y) {
   typedef double Lanes __attribute__((vector_size(64)));
   constexpr int kBlock = 8;
   const long body = rows - rows % 8;
@@ -108,8 +107,7 @@ BEAMRAIL_CLONES void pair_kernel(long rows, long cols, const double* a, const do
     product_kernel<2, false>(rows, cols, a, x, y);
 }
 
-BEAMRAIL_CLONES void six_kernel(long rows, long cols, const double* a, const double* x,
-                                double* y) {
+BEAMRAIL_CLONES void six_kernel(long rows, long cols, const double* a, const double* x, double* y) {
   wide_kernel<6>(rows, cols, a, x, y);
 }
 

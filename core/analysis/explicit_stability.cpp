@@ -1,11 +1,11 @@
 #include "core/analysis/explicit_stability.hpp"
 
-#include <arkode/arkode_butcher_erk.h>
-
-#include <Eigen/SparseCore>
 #include <Spectra/MatOp/SparseCholesky.h>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsSolver.h>
+#include <arkode/arkode_butcher_erk.h>
+
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -80,8 +80,8 @@ double largest_damping(const Model& model) {
   return beta;
 }
 
-FixedStepStability fixed_step_stability(const Model& model, Data& data, const double* y0,
-                                        double t0, const std::string& arkode_table, double h,
+FixedStepStability fixed_step_stability(const Model& model, Data& data, const double* y0, double t0,
+                                        const std::string& arkode_table, double h,
                                         double duration) {
   FixedStepStability out;
   ARKodeButcherTable table = ARKodeButcherTable_LoadERKByName(arkode_table.c_str());
@@ -105,8 +105,8 @@ FixedStepStability fixed_step_stability(const Model& model, Data& data, const do
   // The longest stable step, from h down by 2 % at a time (the growth need not be monotone in
   // the step: the first one within the limit).
   out.stable_step = h;
-  for (int k = 0; k < 2000 && growth(r, out.fastest, beta, out.stable_step, duration) >
-                                  kFixedStepMaxGrowth;
+  for (int k = 0;
+       k < 2000 && growth(r, out.fastest, beta, out.stable_step, duration) > kFixedStepMaxGrowth;
        ++k)
     out.stable_step *= 0.98;
   return out;

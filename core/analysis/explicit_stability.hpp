@@ -30,8 +30,7 @@ struct FixedStepStability {
 // The stability of the explicit ARKODE table `arkode_table` (an ARKODE ERK table name) at the
 // fixed step h over `duration` for the scene at the state y0 (13 states per free body), its
 // undamped modes damped by the stiffness-proportional damping (largest_damping).
-FixedStepStability fixed_step_stability(const Model& model, Data& data, const double* y0,
-                                        double t0, const std::string& arkode_table, double h,
-                                        double duration);
+FixedStepStability fixed_step_stability(const Model& model, Data& data, const double* y0, double t0,
+                                        const std::string& arkode_table, double h, double duration);
 
 }  // namespace beamrail

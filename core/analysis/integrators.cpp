@@ -361,9 +361,9 @@ class ArkodeExplicit : public SundialsIntegrator {
       warnings.push_back(kFixedStepWarning);
       fixed_step_ = true;
       // Nothing would notice modes that grow without bound: refused before the run.
-      const FixedStepStability s = fixed_step_stability(
-          c.model, c.data, N_VGetArrayPointer(y0), 0.0, table, o.fixed_step,
-          o.horizon > 0.0 ? o.horizon : o.fixed_step);
+      const FixedStepStability s =
+          fixed_step_stability(c.model, c.data, N_VGetArrayPointer(y0), 0.0, table, o.fixed_step,
+                               o.horizon > 0.0 ? o.horizon : o.fixed_step);
       if (!s.checked) {
         warnings.push_back(
             "fixed_step: the scene's fastest mode could not be computed; the explicit table's "

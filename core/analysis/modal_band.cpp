@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <array>
-#include <utility>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/modal_integrator.hpp"
@@ -70,9 +70,9 @@ bool change_after(const TimeFunction& f, double t0, double t1, double* rate, dou
 // pieces of the rest (exact for ramps and tables; a smooth ramp or a harmonic factor in at least
 // 64 pieces, 16 per period).
 struct FactorChanges {
-  std::vector<std::pair<double, double>> jumps;      // (time, size)
-  std::vector<std::array<double, 3>> pieces;         // (from, to, slope)
-  double start = 0.0;                                // the first change
+  std::vector<std::pair<double, double>> jumps;  // (time, size)
+  std::vector<std::array<double, 3>> pieces;     // (from, to, slope)
+  double start = 0.0;                            // the first change
 };
 
 FactorChanges factor_changes(const BandExcitation& e, double horizon) {
@@ -223,9 +223,9 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
     // only after the run at its full static response (166 rtol).
     const bool force = e.kind == BandExcitation::Kind::kForce;
     const FactorChanges changes = force ? factor_changes(e, horizon) : FactorChanges{};
-    const bool early = horizon > 0.0 && lowest_positive > 0.0 &&
-                       (horizon - changes.start) * std::sqrt(lowest_positive) <
-                           0.5 * std::numbers::pi;
+    const bool early =
+        horizon > 0.0 && lowest_positive > 0.0 &&
+        (horizon - changes.start) * std::sqrt(lowest_positive) < 0.5 * std::numbers::pi;
     Eigen::MatrixXd response;  // per mode (from `rigid`) and sample time: g_k(tau_j)
     Eigen::VectorXd change;    // the factor's change at the sample times
     if (early) {

@@ -101,8 +101,7 @@ class ModalExponential : public Integrator {
       const Eigen::MatrixXd k = -Eigen::MatrixXd(stiffness_matrix(model, data));
       m0_ = mass_matrix(model, data);
       Eigen::VectorXd values;
-      if (!solve_dense_eigenproblem(0.5 * (k + k.transpose()), Eigen::MatrixXd(m0_), values,
-                                    phi_))
+      if (!solve_dense_eigenproblem(0.5 * (k + k.transpose()), Eigen::MatrixXd(m0_), values, phi_))
         return fail(error, "the modal integrator's eigensolver failed");
       lambda_ = values.array();
       m_ = n_;
@@ -638,13 +637,13 @@ class ModalExponential : public Integrator {
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
   double shift_ = 0.0;            // of K0 + shift M0 in the quasi-static iteration [1/s^2]
   long corrections_ = 0;          // evaluations spent on the quasi-static iteration
-  Eigen::MatrixXd phi_;  // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
-  Eigen::VectorXd m0_v_;  // work space of project
+  Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
+  Eigen::VectorXd m0_v_;          // work space of project
   Eigen::ArrayXd lambda_;
   std::vector<Vec3> c0_;
   std::vector<Vec4> q0_;
   std::vector<Mat3> a0_;
-  Block z_, x_;            // the accepted state, modal and physical (x_ = Phi z_)
+  Block z_, x_;        // the accepted state, modal and physical (x_ = Phi z_)
   Block xi_, x_next_;  // work space: a stage's physical state, a trial step's
   // A trial step's new state and its two error estimates side by side, modal and physical.
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;

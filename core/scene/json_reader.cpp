@@ -26,18 +26,16 @@ size_t edit_distance(const std::string& a, const std::string& b) {
   return prev[b.size()];
 }
 
-// The shortest text that reads back as x ("-8.1e+10", not "-81000000000" or
-// "-1.0000000000000001e-09").
-std::string shortest(double x) {
+}  // namespace
+
+std::string shortest(double x, int min_digits) {
   char buf[32];
-  for (int digits = 1; digits <= 17; ++digits) {
+  for (int digits = min_digits; digits <= 17; ++digits) {
     std::snprintf(buf, sizeof buf, "%.*g", digits, x);
     if (std::strtod(buf, nullptr) == x) break;
   }
   return buf;
 }
-
-}  // namespace
 
 std::string json_type_name(const Json& value) {
   switch (value.type()) {

@@ -26,6 +26,10 @@ struct Where {
   Where operator/(size_t index) const { return {file, pointer + "/" + std::to_string(index)}; }
 };
 
+// The shortest text with at least min_digits significant digits that reads back as x
+// ("-8.1e+10", not "-81000000000" or "-1.0000000000000001e-09").
+std::string shortest(double x, int min_digits = 1);
+
 // The JSON type of a value, as a user would name it ("number", "string", ...).
 std::string json_type_name(const Json& value);
 

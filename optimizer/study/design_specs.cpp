@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <set>
 
 #include "optimizer/study/design_study.hpp"
@@ -13,17 +12,6 @@
 
 namespace beamrail {
 namespace {
-
-// A number in a method's label: %g's six digits when they read back as it, else as many as it
-// takes (fixed steps of 1e-4 and 1.0000001e-4 were one label over two rows of different error).
-std::string label_number(double x) {
-  char text[32];
-  for (int digits = 6; digits <= 17; ++digits) {
-    std::snprintf(text, sizeof text, "%.*g", digits, x);
-    if (std::strtod(text, nullptr) == x) break;
-  }
-  return text;
-}
 
 int response_index(const Study& study, const std::string& name) {
   for (size_t k = 0; k < study.responses.size(); ++k)
@@ -327,12 +315,13 @@ void read_work_precision(ObjectReader& r, const Study& study, DesignStudy& d) {
         if (m.is_object() && m.contains("max_order"))
           method.label.append(" order<=").append(std::to_string(io.max_order));
         if (!io.about.empty()) method.label.append(" about ").append(io.about);
-        // Labels tell the methods apart (label_number).
+        // Labels tell the methods apart: %g's six digits, or as many as read back as the number
+        // (fixed steps of 1e-4 and 1.0000001e-4 were one label over two rows of different error).
         if (io.max_frequency_hz > 0.0)
-          method.label.append(" band ").append(label_number(io.max_frequency_hz)).append(" Hz");
+          method.label.append(" band ").append(shortest(io.max_frequency_hz, 6)).append(" Hz");
         if (io.choose_band) method.label += " band auto";
         if (io.fixed_step > 0.0)
-          method.label.append(" fixed_step ").append(label_number(io.fixed_step)).append(" s");
+          method.label.append(" fixed_step ").append(shortest(io.fixed_step, 6)).append(" s");
         if (io.linear_solver != LinearSolverKind::kAuto)
           method.label.append(io.linear_solver == LinearSolverKind::kDense ? " dense" : " sparse");
         p.methods.push_back(method);

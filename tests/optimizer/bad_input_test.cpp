@@ -337,8 +337,9 @@ TEST_F(BadInput, FixedStepAgainstTheRun) {
     double step;
     const char* message;
   } cases[] = {{0.02, "fixed_step must not exceed t_end"},
-               {1e-300, "fixed_step 1e-300 s takes 1e+298 steps over t_end, more than max_steps "
-                        "(10000000)"}};
+               {1e-300,
+                "fixed_step 1e-300 s takes 1e+298 steps over t_end, more than max_steps "
+                "(10000000)"}};
   for (const auto& c : cases) {
     Json study = base();  // t_end 0.01
     study["analyses"][0]["integrator"]["method"] = "erk";

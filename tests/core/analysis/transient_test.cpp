@@ -248,10 +248,10 @@ void expect_step_load_acts_from_its_time(const std::string& at, double output_st
         motion = std::max(motion, e.norm());
       }
     }
-    std::printf("step at %s s, %s%s: before the jump %.1e m, after it %.1e of the motion from the "
-                "shifted run\n",
-                at.c_str(), m.name, m.fixed_step > 0.0 ? " fixed_step" : "", before,
-                after / motion);
+    std::printf(
+        "step at %s s, %s%s: before the jump %.1e m, after it %.1e of the motion from the "
+        "shifted run\n",
+        at.c_str(), m.name, m.fixed_step > 0.0 ? " fixed_step" : "", before, after / motion);
     EXPECT_LT(before, 1e-14) << m.name;         // the rounding of 1 m coordinates
     EXPECT_LT(after / motion, 1e-7) << m.name;  // 100 rtol
   }

@@ -444,6 +444,7 @@ class Runner {
     v.message = r.message;
     v.stats = r.stats;
     v.error = r.ok ? trajectory_error(run, reference) : kNaN;
+    v.rotation_error = r.ok ? trajectory_rotation_error(run, reference) : kNaN;
     return v;
   }
 

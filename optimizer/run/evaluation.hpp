@@ -29,6 +29,7 @@ struct Verification {
   double rtol = 0.0, atol = 0.0;  // of the tighter run
   double fixed_step = 0.0;        // of the tighter run (half the run's); 0: adaptive
   double error = 0.0;             // largest body-centre distance between the runs / largest motion
+  double rotation_error = 0.0;    // largest angle between the runs' orientations / largest turn
   SolverStats stats;              // of the tighter run
 };
 

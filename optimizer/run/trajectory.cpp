@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/model/rotation.hpp"
+
 namespace beamrail {
 
 Trajectory trajectory_of(const Model& model) {
@@ -14,7 +16,10 @@ Trajectory trajectory_of(const Model& model) {
 
 void Trajectory::record(const TransientSample& sample, const Data& data) {
   times.push_back(sample.t);
-  for (int i : bodies) positions.push_back(data.pose[i].u);
+  for (int i : bodies) {
+    positions.push_back(data.pose[i].u);
+    orientations.push_back(data.pose[i].A);
+  }
 }
 
 double trajectory_error(const Trajectory& run, const Trajectory& reference) {
@@ -29,6 +34,28 @@ double trajectory_error(const Trajectory& run, const Trajectory& reference) {
   for (size_t k = 0; k < samples; ++k)
     for (size_t b = 0; b < nb; ++b)
       error = std::max(error, (run.positions[k * nb + b] - reference.positions[k * nb + b]).norm());
+  if (!(motion > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return error / motion;
+}
+
+double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference) {
+  const size_t nb = reference.bodies.size();
+  const size_t samples = std::min(run.times.size(), reference.times.size());
+  if (samples == 0 || nb == 0 || run.bodies.size() != nb ||
+      run.orientations.size() != run.positions.size() ||
+      reference.orientations.size() != reference.positions.size())
+    return std::numeric_limits<double>::quiet_NaN();
+  // The angle of the rotation a^T b.
+  const auto angle = [](const Mat3& a, const Mat3& b) {
+    return rotation_vector(Mat3(a.transpose() * b)).norm();
+  };
+  const std::vector<Mat3>& r = reference.orientations;
+  double error = 0.0, motion = 0.0;
+  for (size_t k = 0; k < reference.times.size(); ++k)
+    for (size_t b = 0; b < nb; ++b) motion = std::max(motion, angle(r[b], r[k * nb + b]));
+  for (size_t k = 0; k < samples; ++k)
+    for (size_t b = 0; b < nb; ++b)
+      error = std::max(error, angle(run.orientations[k * nb + b], r[k * nb + b]));
   if (!(motion > 0.0)) return std::numeric_limits<double>::quiet_NaN();
   return error / motion;
 }

@@ -9,9 +9,10 @@
 namespace beamrail {
 
 struct Trajectory {
-  std::vector<int> bodies;      // the scene's own free bodies
-  std::vector<double> times;    // [s]
-  std::vector<Vec3> positions;  // displacement of each body's centre at each time, time-major
+  std::vector<int> bodies;         // the scene's own free bodies
+  std::vector<double> times;       // [s]
+  std::vector<Vec3> positions;     // displacement of each body's centre at each time, time-major
+  std::vector<Mat3> orientations;  // each body's rotation (body -> global), like positions
   void record(const TransientSample& sample, const Data& data);
 };
 
@@ -22,5 +23,12 @@ Trajectory trajectory_of(const Model& model);
 // largest distance a reference body moved from its start; NaN when the runs share no time or the
 // reference does not move.
 double trajectory_error(const Trajectory& run, const Trajectory& reference);
+
+// The same for orientations: the largest angle between the runs' orientations of a body over the
+// common times, relative to the largest angle a reference body turned from its start (both the
+// angles of relative rotations, at most pi); NaN when nothing can be compared or no reference body
+// turns. A run wrong only in its rotations (a spinning body's phase) shows here, not in the
+// centres.
+double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference);
 
 }  // namespace beamrail

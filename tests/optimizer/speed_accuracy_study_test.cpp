@@ -187,6 +187,61 @@ TEST_F(SpeedAccuracyRuns, VerifyHalvesAFixedStep) {
   EXPECT_LT(estimate / measured, 1.1);
 }
 
+// A run wrong only in its rotations: a disk on a 1 m steel rod of 10 mm diameter twisted by a
+// 0.08 N m step torque about the rod. Its centre stays where it is; it turns by
+// theta(t) = (T / k) (1 - cos w t), k = G Ix / L, w^2 = k / I. "verify" gives the angle between
+// the run's orientations and the tighter run's relative to the largest turn, which must agree
+// with the same measured against a tight run (rtol 1e-11), and that run with the closed form.
+TEST_F(SpeedAccuracyRuns, VerifyMeasuresARunWrongOnlyInItsRotations) {
+  Json s = Json::parse(R"({"name": "twist",
+    "scene": {"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+      "sections": {"rod": {"shape": "circle", "diameter": 0.01}},
+      "bodies": [{"name": "disk", "mass": 1.0, "inertia": [0.02, 0.01, 0.01], "position": [1, 0, 0]}],
+      "beams": [{"name": "rod", "body1": "ground", "body2": "disk", "point1": [0, 0, 0],
+                 "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "rod"}],
+      "loads": [{"type": "torque", "body": "disk", "value": [0.08, 0, 0],
+                 "time": {"type": "step", "at": 0.0}}]},
+    "analyses": [{"type": "transient", "t_end": 0.2, "output_step": 1e-3,
+                  "integrator": {"method": "bdf", "rtol": 1e-5, "atol": 1e-9}, "verify": true}]})");
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("run.json", s), "run"));
+  s["analyses"][0]["integrator"] =
+      Json::parse(R"({"method": "bdf", "rtol": 1e-11, "atol": 1e-15})");
+  s["analyses"][0]["verify"] = false;
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("tight.json", s), "tight"));
+  const Table run = read_table(dir_ / "run" / "timeseries.csv");
+  const Table tight = read_table(dir_ / "tight" / "timeseries.csv");
+  ASSERT_EQ(run.rows.size(), 201u);
+  ASSERT_EQ(tight.rows.size(), 201u);
+  const auto angle = [](const Table& t, size_t i) {  // about x
+    return 2.0 * std::atan2(std::stod(t.at(i, "disk.q1")), std::stod(t.at(i, "disk.q0")));
+  };
+  const double k = 8.0769e10 * M_PI * std::pow(0.01, 4) / 32.0, w = std::sqrt(k / 0.02);
+  double error = 0.0, turn = 0.0, closed_form = 0.0;
+  for (size_t i = 0; i < run.rows.size(); ++i) {
+    const double t = std::stod(tight.at(i, "t")), exact = 0.08 / k * (1.0 - std::cos(w * t));
+    error = std::max(error, std::abs(angle(run, i) - angle(tight, i)));
+    turn = std::max(turn, std::abs(angle(tight, i)));
+    closed_form = std::max(closed_form, std::abs(angle(tight, i) - exact));
+  }
+  const Json summary = load_json(dir_ / "run" / "summary.json");
+  const Json& v = summary["analyses"][0]["verification"];
+  ASSERT_TRUE(v.is_object()) << summary.dump(2);
+  EXPECT_EQ(v["status"], "ok");
+  ASSERT_TRUE(v["rotation_error"].is_number()) << v.dump(2);
+  const double estimate = v["rotation_error"], measured = error / turn;
+  std::printf(
+      "twisted disk, bdf rtol 1e-5: largest turn %.4g rad (closed form %.4g, the tight run %.2g "
+      "rad from it); rotation error %.4g against rtol 1e-11, %.4g from verify (ratio %.3f); "
+      "centre error %s\n",
+      turn, 2 * 0.08 / k, closed_form, measured, estimate, estimate / measured,
+      v["error"].dump().c_str());
+  EXPECT_NEAR(turn, 2 * 0.08 / k, 1e-3 * turn);  // the model's torsion is G Ix / L
+  EXPECT_LT(closed_form, 1e-6 * turn);
+  EXPECT_GT(measured, 1e-7);  // a run with an error to find
+  EXPECT_GT(estimate / measured, 2.0 / 3.0);
+  EXPECT_LT(estimate / measured, 4.0 / 3.0);
+}
+
 TEST_F(SpeedAccuracyRuns, ADesignPastItsBudgetIsATimeoutRowAndTheBatchGoesOn) {
   Json s = load_json(kStudies / "work_precision_reference.json");
   s["analyses"][0]["t_end"] = 0.01;

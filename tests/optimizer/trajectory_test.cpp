@@ -7,6 +7,8 @@
 
 #include <cmath>
 
+#include "core/model/rotation.hpp"
+
 namespace beamrail {
 namespace {
 
@@ -46,6 +48,37 @@ TEST(Trajectory, NothingToCompareIsNaN) {
   EXPECT_TRUE(std::isnan(trajectory_error(other, reference)));
   const Trajectory still = moving(1);  // a reference that does not move
   EXPECT_TRUE(std::isnan(trajectory_error(still, still)));
+}
+
+// A body turning about z by 0.2 rad per sample (2 rad at most) and a still one; the run's first
+// body is off by 1e-3 rad about x at sample 6, its second by 4e-4 rad about y at sample 2: the
+// angle between the orientations (a closed form: R^T (R Q) = Q) over the largest turn.
+TEST(Trajectory, TheRotationErrorIsTheLargestAngleOverTheLargestTurn) {
+  const auto turning = [](int samples) {
+    Trajectory t = moving(samples);
+    for (int k = 0; k < samples; ++k) {
+      t.orientations.push_back(
+          rotation_matrix<double>(quat_from_rotation_vector(Vec3(0, 0, 0.2 * k))));
+      t.orientations.push_back(Mat3::Identity());
+    }
+    return t;
+  };
+  const Trajectory reference = turning(11);
+  Trajectory run = turning(11);
+  const auto turn = [](const Vec3& r) {
+    return rotation_matrix<double>(quat_from_rotation_vector(r));
+  };
+  run.orientations[2 * 6] = run.orientations[2 * 6] * turn(Vec3(1e-3, 0, 0));
+  run.orientations[2 * 2 + 1] = turn(Vec3(0, 4e-4, 0));
+  EXPECT_NEAR(trajectory_rotation_error(run, reference), 1e-3 / 2.0, 1e-15);
+  EXPECT_EQ(trajectory_rotation_error(reference, reference), 0.0);
+  // The centres agree: the position measure does not see it.
+  EXPECT_EQ(trajectory_error(run, reference), 0.0);
+  // Nothing turns, or no orientations recorded: nothing to measure against.
+  Trajectory still = turning(11);
+  for (Mat3& a : still.orientations) a.setIdentity();
+  EXPECT_TRUE(std::isnan(trajectory_rotation_error(still, still)));
+  EXPECT_TRUE(std::isnan(trajectory_rotation_error(moving(11), moving(11))));
 }
 
 }  // namespace

@@ -7,13 +7,6 @@
 // this kernel (both columns in one pass over the matrix, eight matrix columns at a time, compiled
 // for several instruction sets with the one the CPU has chosen at load time) twice again:
 // measured at n = 240 on the reference machine, 28 us, 15 us and 7.1 us.
-//
-// Threads: a product of more than 2^17 multiply-adds outside a parallel region spreads over the
-// run's OpenMP threads (-j; all cores by default) in slabs of rows (of columns for the transposed
-// one), each a multiple of 8 long, so that every entry is summed by one thread in the order one
-// thread would: the results are the same bits for any number of threads. Inside a parallel region
-// (a batch's designs on their threads) a product stays on its thread. The braced tower's
-// every-mode run (1,038 dof, 1 s) on two threads: 0.73 of the wall time on one.
 #pragma once
 
 #include <Eigen/Core>
@@ -30,8 +23,5 @@ void multiply_three_pairs(const Eigen::MatrixXd& a, const double* x, double* y);
 
 // y = a x for the vectors x (length a.cols()) and y (length a.rows()).
 void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y);
-
-// y = a^T x for the vectors x (length a.rows()) and y (length a.cols()).
-void multiply_transposed(const Eigen::MatrixXd& a, const double* x, double* y);
 
 }  // namespace beamrail

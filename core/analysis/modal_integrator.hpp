@@ -23,8 +23,8 @@
 // Cost: one dense eigenproblem (n_dofs^3) at set-up, then per stage one dense product with two
 // columns (x, u = Phi (eta, nu); core/analysis/dense_product) and one transposed product with
 // one (Phi^T (M0 a), M0 a 6 x 6 block per body: Phi is the one dense matrix stored, and a stored
-// M0 Phi beside it made the braced tower's every-mode run 26 % slower per step), spread over the
-// run's threads; hence a size limit. Accuracy degrades with the size of the motion: past kMaxRotation the run
+// M0 Phi beside it made the braced tower's every-mode run 26 % slower per step); hence a size
+// limit. Accuracy degrades with the size of the motion: past kMaxRotation the run
 // stops with a message naming the body.
 //
 // Band-limited (IntegratorOptions::max_frequency_hz): only the m modes up to the band are

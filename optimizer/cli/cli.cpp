@@ -1,7 +1,5 @@
 #include "optimizer/cli/cli.hpp"
 
-#include <omp.h>
-
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -44,8 +42,7 @@ Commands:
 Options:
   -o, --output OUTDIR   where to write the results
   -j, --threads N       threads for batch evaluation, 1..1024 (default: all cores; never
-                        more than the designs evaluated at once); a single run's modal
-                        products also use them
+                        more than the designs evaluated at once)
   --resume              continue an interrupted sweep or optimization in OUTDIR (refused
                         when OUTDIR's tables were written by another version of the study)
   --quiet               no progress output
@@ -280,13 +277,6 @@ int run(const RunArguments& args) {
                  "rank 0 alone (the other "
               << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
-  // A single run's dense products (the modal method's changes of basis,
-  // core/analysis/dense_product.hpp) take -j threads, all cores by default, one per rank under
-  // mpirun; a batch's designs set their own.
-  if (args.threads > 0)
-    omp_set_num_threads(args.threads);
-  else if (const MpiJob* job = mpi_job(); job && job->size() > 1)
-    omp_set_num_threads(1);
   if (study->design) {
     int status = 0;
     switch (study->design->type) {

@@ -124,7 +124,8 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
             {"rotation_error", json_number(v->rotation_error)},
             {"rotation_error_measure",
              "largest angle between body orientations of the run and of the tighter run, "
-             "relative to the largest angle a body turned (null when none turns)"},
+             "relative to the largest angle a body turned (null when none turns more than 1e-9 "
+             "rad)"},
             {"wall_seconds", v->stats.wall_seconds},
             {"steps", v->stats.steps},
             {"rhs_evaluations", v->stats.rhs_evaluations},

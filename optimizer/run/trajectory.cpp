@@ -18,7 +18,7 @@ void Trajectory::record(const TransientSample& sample, const Data& data) {
   times.push_back(sample.t);
   for (int i : bodies) {
     positions.push_back(data.pose[i].u);
-    orientations.push_back(data.pose[i].A);
+    orientations.push_back(data.q[i]);
   }
 }
 
@@ -45,18 +45,27 @@ double trajectory_rotation_error(const Trajectory& run, const Trajectory& refere
       run.orientations.size() != run.positions.size() ||
       reference.orientations.size() != reference.positions.size())
     return std::numeric_limits<double>::quiet_NaN();
-  // The angle of the rotation a^T b.
-  const auto angle = [](const Mat3& a, const Mat3& b) {
-    return rotation_vector(Mat3(a.transpose() * b)).norm();
+  // The angle of the rotation from a to b (Euler parameters, either sign, any norm).
+  const auto angle = [](const Vec4& a, const Vec4& b) {
+    const Vec4 r = quat_multiply(Vec4(a(0), -a(1), -a(2), -a(3)), b);
+    return 2.0 * std::atan2(r.tail<3>().norm(), std::abs(r(0)));
   };
-  const std::vector<Mat3>& r = reference.orientations;
+  const std::vector<Vec4>& r = reference.orientations;
   double error = 0.0, motion = 0.0;
+  bool finite = true;
   for (size_t k = 0; k < reference.times.size(); ++k)
-    for (size_t b = 0; b < nb; ++b) motion = std::max(motion, angle(r[b], r[k * nb + b]));
+    for (size_t b = 0; b < nb; ++b) {
+      const double a = angle(r[b], r[k * nb + b]);
+      finite = finite && std::isfinite(a);
+      motion = std::max(motion, a);
+    }
   for (size_t k = 0; k < samples; ++k)
-    for (size_t b = 0; b < nb; ++b)
-      error = std::max(error, angle(run.orientations[k * nb + b], r[k * nb + b]));
-  if (!(motion > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    for (size_t b = 0; b < nb; ++b) {
+      const double a = angle(run.orientations[k * nb + b], r[k * nb + b]);
+      finite = finite && std::isfinite(a);
+      error = std::max(error, a);
+    }
+  if (!finite || !(motion > kLeastTurn)) return std::numeric_limits<double>::quiet_NaN();
   return error / motion;
 }
 

@@ -12,7 +12,7 @@ struct Trajectory {
   std::vector<int> bodies;         // the scene's own free bodies
   std::vector<double> times;       // [s]
   std::vector<Vec3> positions;     // displacement of each body's centre at each time, time-major
-  std::vector<Mat3> orientations;  // each body's rotation (body -> global), like positions
+  std::vector<Vec4> orientations;  // each body's Euler parameters (body -> global), like positions
   void record(const TransientSample& sample, const Data& data);
 };
 
@@ -26,9 +26,11 @@ double trajectory_error(const Trajectory& run, const Trajectory& reference);
 
 // The same for orientations: the largest angle between the runs' orientations of a body over the
 // common times, relative to the largest angle a reference body turned from its start (both the
-// angles of relative rotations, at most pi); NaN when nothing can be compared or no reference body
-// turns. A run wrong only in its rotations (a spinning body's phase) shows here, not in the
-// centres.
+// angles of relative rotations, at most pi); NaN when nothing can be compared, an angle is not
+// finite, or no reference body turns more than kLeastTurn (a body that does not turn has angles
+// of rounding, 1e-20 rad and less, which a ratio would make an error of order one). A run wrong
+// only in its rotations (a spinning body's phase) shows here, not in the centres.
+inline constexpr double kLeastTurn = 1e-9;  // [rad]
 double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference);
 
 }  // namespace beamrail

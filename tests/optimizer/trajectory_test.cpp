@@ -52,33 +52,37 @@ TEST(Trajectory, NothingToCompareIsNaN) {
 
 // A body turning about z by 0.2 rad per sample (2 rad at most) and a still one; the run's first
 // body is off by 1e-3 rad about x at sample 6, its second by 4e-4 rad about y at sample 2: the
-// angle between the orientations (a closed form: R^T (R Q) = Q) over the largest turn.
+// angle between the orientations (a closed form: (q p) relative to q is p) over the largest turn.
 TEST(Trajectory, TheRotationErrorIsTheLargestAngleOverTheLargestTurn) {
   const auto turning = [](int samples) {
     Trajectory t = moving(samples);
     for (int k = 0; k < samples; ++k) {
-      t.orientations.push_back(
-          rotation_matrix<double>(quat_from_rotation_vector(Vec3(0, 0, 0.2 * k))));
-      t.orientations.push_back(Mat3::Identity());
+      t.orientations.push_back(quat_from_rotation_vector(Vec3(0, 0, 0.2 * k)));
+      t.orientations.push_back(Vec4(1, 0, 0, 0));
     }
     return t;
   };
   const Trajectory reference = turning(11);
   Trajectory run = turning(11);
-  const auto turn = [](const Vec3& r) {
-    return rotation_matrix<double>(quat_from_rotation_vector(r));
-  };
-  run.orientations[2 * 6] = run.orientations[2 * 6] * turn(Vec3(1e-3, 0, 0));
-  run.orientations[2 * 2 + 1] = turn(Vec3(0, 4e-4, 0));
+  run.orientations[2 * 6] =
+      quat_multiply(run.orientations[2 * 6], quat_from_rotation_vector(Vec3(1e-3, 0, 0)));
+  run.orientations[2 * 2 + 1] = -quat_from_rotation_vector(Vec3(0, 4e-4, 0));  // either sign
   EXPECT_NEAR(trajectory_rotation_error(run, reference), 1e-3 / 2.0, 1e-15);
   EXPECT_EQ(trajectory_rotation_error(reference, reference), 0.0);
   // The centres agree: the position measure does not see it.
   EXPECT_EQ(trajectory_error(run, reference), 0.0);
-  // Nothing turns, or no orientations recorded: nothing to measure against.
-  Trajectory still = turning(11);
-  for (Mat3& a : still.orientations) a.setIdentity();
-  EXPECT_TRUE(std::isnan(trajectory_rotation_error(still, still)));
+  // Nothing to measure against: no orientations recorded, or no body turning beyond rounding
+  // (1e-20 rad: a bar pulled along its axis), or an orientation that is not finite.
   EXPECT_TRUE(std::isnan(trajectory_rotation_error(moving(11), moving(11))));
+  Trajectory still = turning(11);
+  for (size_t i = 0; i < still.orientations.size(); ++i)
+    still.orientations[i] = quat_from_rotation_vector(Vec3(0, 0, 1e-20 * (i % 3)));
+  Trajectory still_run = still;
+  still_run.orientations[5] = quat_from_rotation_vector(Vec3(3e-20, 0, 0));
+  EXPECT_TRUE(std::isnan(trajectory_rotation_error(still_run, still)));
+  Trajectory broken = run;
+  broken.orientations[7](1) = std::nan("");
+  EXPECT_TRUE(std::isnan(trajectory_rotation_error(broken, reference)));
 }
 
 }  // namespace

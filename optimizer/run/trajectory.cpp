@@ -34,7 +34,7 @@ double trajectory_error(const Trajectory& run, const Trajectory& reference) {
   for (size_t k = 0; k < samples; ++k)
     for (size_t b = 0; b < nb; ++b)
       error = std::max(error, (run.positions[k * nb + b] - reference.positions[k * nb + b]).norm());
-  if (!(motion > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  if (!(motion > kLeastMotion)) return std::numeric_limits<double>::quiet_NaN();
   return error / motion;
 }
 

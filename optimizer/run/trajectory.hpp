@@ -20,8 +20,10 @@ struct Trajectory {
 Trajectory trajectory_of(const Model& model);
 
 // The largest distance between the runs' body centres over the common times, relative to the
-// largest distance a reference body moved from its start; NaN when the runs share no time or the
-// reference does not move.
+// largest distance a reference body moved from its start; NaN when the runs share no time or no
+// reference body moves more than kLeastMotion (rounding, which a ratio would turn into an error
+// of any size).
+inline constexpr double kLeastMotion = 1e-12;  // [m]
 double trajectory_error(const Trajectory& run, const Trajectory& reference);
 
 // The same for orientations: the largest angle between the runs' orientations of a body over the

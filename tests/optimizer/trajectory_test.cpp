@@ -48,6 +48,10 @@ TEST(Trajectory, NothingToCompareIsNaN) {
   EXPECT_TRUE(std::isnan(trajectory_error(other, reference)));
   const Trajectory still = moving(1);  // a reference that does not move
   EXPECT_TRUE(std::isnan(trajectory_error(still, still)));
+  Trajectory rounding = moving(11);  // one that moves by rounding only
+  for (size_t i = 0; i < rounding.positions.size(); ++i)
+    rounding.positions[i] = Vec3(1e-17 * (i % 4), 0.0, 1.0);
+  EXPECT_TRUE(std::isnan(trajectory_error(moving(11), rounding)));
 }
 
 // A body turning about z by 0.2 rad per sample (2 rad at most) and a still one; the run's first

@@ -496,8 +496,7 @@ class ModalExponential : public Integrator {
   // second-order one sees that. Measured against tight explicit runs over rtol 1e-4 .. 1e-9
   // (transient_auto_test.cpp, ErrorFollowsTheTolerance, auto): 0.011 .. 0.060 rtol on the
   // reference cantilever in 10 segments, 0.017 .. 1.3 on that torsion case, 0.13 .. 1.9 on the
-  // tumbling pair (relinearized); the second-order estimate alone (before) gave 1e-2 .. 1e-5
-  // rtol on the cantilevers (the README's figure before this change).
+  // tumbling pair (relinearized); the second-order estimate alone gave 1e-2 .. 1e-5 rtol there.
   // Where it costs: the braced tower of the README (1,038 dof, 2 kN step, rtol 1e-6, atol 1e-9,
   // 0.2 s) takes 797 steps held by the second-order estimate, almost all of it in the angular
   // velocities (atol-weighted: they are near zero), and leaves 0.03 rtol. The forcing there is
@@ -506,8 +505,8 @@ class ModalExponential : public Integrator {
   // ErrorFollowsTheTolerance: the second-order estimate at 0.1 of its weight (tower 298 steps,
   // 0.4 rtol) leaves 20 rtol on the step-torque case at rtol 1e-5; on positions only, or the
   // third-order one alone (185 steps, 2.6 rtol), 16 .. 476 rtol there; from stages 1 and 4
-  // (exponential trapezoid) instead of 1 and 2, 741 steps; weights rtol |omega| + atol per body
-  // (free of the axes): 445 steps, 14 .. 99 rtol there (small bending rates set the deflection).
+  // (exponential trapezoid) instead of 1 and 2, 741 steps; weights rtol |omega| + atol per body:
+  // 445 steps, 14 .. 99 rtol there (small bending rates beside the torsion set the deflection).
   static constexpr double kExponent = 0.25;
   // The quasi-static iteration stops when its correction is below this part of the error
   // weights: what is left of it enters the forcing through the stiffness of the modes above the

@@ -120,7 +120,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
             {"error", json_number(v->error)},
             {"error_measure",
              "largest distance between body centres of the run and of the tighter run, relative "
-             "to the largest distance a body moved"},
+             "to the largest distance a body moved (null when none moves more than 1e-12 m)"},
             {"rotation_error", json_number(v->rotation_error)},
             {"rotation_error_measure",
              "largest angle between body orientations of the run and of the tighter run, "

@@ -22,51 +22,52 @@ void Trajectory::record(const TransientSample& sample, const Data& data) {
   }
 }
 
-double trajectory_error(const Trajectory& run, const Trajectory& reference) {
-  const size_t nb = reference.bodies.size();
-  const size_t samples = std::min(run.times.size(), reference.times.size());
-  if (samples == 0 || nb == 0 || run.bodies.size() != nb)
-    return std::numeric_limits<double>::quiet_NaN();
-  double error = 0.0, motion = 0.0;
-  for (size_t k = 0; k < reference.times.size(); ++k)
-    for (size_t b = 0; b < nb; ++b)
-      motion = std::max(motion, (reference.positions[k * nb + b] - reference.positions[b]).norm());
-  for (size_t k = 0; k < samples; ++k)
-    for (size_t b = 0; b < nb; ++b)
-      error = std::max(error, (run.positions[k * nb + b] - reference.positions[k * nb + b]).norm());
-  if (!(motion > kLeastMotion)) return std::numeric_limits<double>::quiet_NaN();
-  return error / motion;
-}
+namespace {
 
-double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference) {
+// The largest distance between the runs' values of a body over the common samples, relative to
+// the largest distance of a reference value from the body's first (values: time-major, one per
+// body); NaN when nothing can be compared, a distance is not finite, or the reference moves no
+// more than `least`.
+template <class Value, class Distance>
+double relative_error(const Trajectory& run, const Trajectory& reference,
+                      const std::vector<Value>& run_values, const std::vector<Value>& values,
+                      Distance distance, double least) {
   const size_t nb = reference.bodies.size();
   const size_t samples = std::min(run.times.size(), reference.times.size());
   if (samples == 0 || nb == 0 || run.bodies.size() != nb ||
-      run.orientations.size() != run.positions.size() ||
-      reference.orientations.size() != reference.positions.size())
+      run_values.size() != run.times.size() * nb || values.size() != reference.times.size() * nb)
     return std::numeric_limits<double>::quiet_NaN();
+  double error = 0.0, motion = 0.0;
+  bool finite = true;
+  const auto widen = [&finite](double& largest, double d) {
+    finite = finite && std::isfinite(d);
+    largest = std::max(largest, d);
+  };
+  for (size_t k = 0; k < reference.times.size(); ++k)
+    for (size_t b = 0; b < nb; ++b) widen(motion, distance(values[b], values[k * nb + b]));
+  for (size_t k = 0; k < samples; ++k)
+    for (size_t b = 0; b < nb; ++b)
+      widen(error, distance(run_values[k * nb + b], values[k * nb + b]));
+  if (!finite || !(motion > least)) return std::numeric_limits<double>::quiet_NaN();
+  return error / motion;
+}
+
+}  // namespace
+
+double trajectory_error(const Trajectory& run, const Trajectory& reference) {
+  return relative_error(
+      run, reference, run.positions, reference.positions,
+      [](const Vec3& a, const Vec3& b) { return (a - b).norm(); }, kLeastMotion);
+}
+
+double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference) {
   // The angle of the rotation from a to b (Euler parameters, either sign, any norm).
   const auto angle = [](const Vec4& a, const Vec4& b) {
     const Vec4 r = quat_multiply(Vec4(a(0), -a(1), -a(2), -a(3)), b);
     return 2.0 * std::atan2(r.tail<3>().norm(), std::abs(r(0)));
   };
-  const std::vector<Vec4>& r = reference.orientations;
-  double error = 0.0, motion = 0.0;
-  bool finite = true;
-  for (size_t k = 0; k < reference.times.size(); ++k)
-    for (size_t b = 0; b < nb; ++b) {
-      const double a = angle(r[b], r[k * nb + b]);
-      finite = finite && std::isfinite(a);
-      motion = std::max(motion, a);
-    }
-  for (size_t k = 0; k < samples; ++k)
-    for (size_t b = 0; b < nb; ++b) {
-      const double a = angle(run.orientations[k * nb + b], r[k * nb + b]);
-      finite = finite && std::isfinite(a);
-      error = std::max(error, a);
-    }
-  if (!finite || !(motion > kLeastTurn)) return std::numeric_limits<double>::quiet_NaN();
-  return error / motion;
+  return relative_error(run, reference, run.orientations, reference.orientations, angle,
+                        kLeastTurn);
 }
 
 }  // namespace beamrail

@@ -130,4 +130,69 @@ class StudyRuns : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
+// The table text with the named column's fields emptied (header kept), every other byte as is.
+inline std::string without_column(const std::string& text, const std::string& name) {
+  bool whole = true;
+  const std::vector<std::string> lines = lines_of(text, &whole);
+  if (lines.empty()) return text;
+  const std::vector<std::string> header = raw_fields(lines[0]);
+  const auto it = std::find(header.begin(), header.end(), name);
+  if (it == header.end()) {
+    ADD_FAILURE() << "no column \"" << name << "\" in " << lines[0];
+    return text;
+  }
+  const size_t column = static_cast<size_t>(it - header.begin());
+  std::string out;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    std::vector<std::string> fields = raw_fields(lines[i]);
+    if (i > 0 && column < fields.size()) fields[column].clear();
+    for (size_t k = 0; k < fields.size(); ++k) out += (k ? "," : "") + fields[k];
+    if (i + 1 < lines.size() || whole) out += '\n';
+  }
+  return out;
+}
+
+// Text equality with the first differing line in the message.
+inline ::testing::AssertionResult SameText(const std::string& a, const std::string& b) {
+  if (a == b) return ::testing::AssertionSuccess();
+  const std::vector<std::string> la = lines_of(a), lb = lines_of(b);
+  for (size_t i = 0; i < std::max(la.size(), lb.size()); ++i) {
+    const std::string x = i < la.size() ? la[i] : "<none>", y = i < lb.size() ? lb[i] : "<none>";
+    if (x != y)
+      return ::testing::AssertionFailure()
+             << "line " << i + 1 << " differs (" << la.size() << " vs " << lb.size()
+             << " lines):\n  " << x << "\n  " << y;
+  }
+  return ::testing::AssertionFailure() << "the texts differ in their last newline";
+}
+
+// Fields first .. first + count - 1 of a CSV line without quoted fields, joined by commas.
+inline std::string fields_of(const std::string& line, size_t first, size_t count) {
+  std::vector<std::string> f;
+  size_t start = 0;
+  for (size_t i = 0; i <= line.size(); ++i)
+    if (i == line.size() || line[i] == ',')
+      f.push_back(line.substr(start, i - start)), start = i + 1;
+  std::string out;
+  for (size_t i = first; i < first + count && i < f.size(); ++i)
+    out += (out.empty() ? "" : ",") + f[i];
+  return out;
+}
+
+// studies/tube_cantilever_sweep.json (in `studies`) with an n_d x n_w grid (outer diameter 20..60
+// mm, wall 1..5 mm) and, when segments > 0, a segmented (slower) beam.
+inline nlohmann::json tube_grid(const std::filesystem::path& studies, int n_d, int n_w,
+                                int segments = 0) {
+  nlohmann::json s = load_json(studies / "tube_cantilever_sweep.json");
+  nlohmann::json& v = s["study"]["variables"];
+  v[0]["count"] = n_d;
+  v[1] = nlohmann::json{{"name", "wall"},
+                        {"pointer", "/scene/sections/tube/wall"},
+                        {"lower", 0.001},
+                        {"upper", 0.005},
+                        {"count", n_w}};
+  if (segments > 0) s["scene"]["beams"][0]["segments"] = segments;
+  return s;
+}
+
 }  // namespace beamrail::testing

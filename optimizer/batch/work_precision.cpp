@@ -45,6 +45,10 @@ void put_trajectory(Packer& p, const Trajectory& t) {
   xyz.reserve(3 * t.positions.size());
   for (const Vec3& v : t.positions) xyz.insert(xyz.end(), {v.x(), v.y(), v.z()});
   p.put_doubles(xyz);
+  std::vector<double> quaternions;
+  quaternions.reserve(4 * t.orientations.size());
+  for (const Vec4& q : t.orientations) quaternions.insert(quaternions.end(), {q(0), q(1), q(2), q(3)});
+  p.put_doubles(quaternions);
 }
 
 Trajectory get_trajectory(Unpacker& u) {
@@ -55,6 +59,10 @@ Trajectory get_trajectory(Unpacker& u) {
   const std::vector<double> xyz = u.get_doubles();
   for (size_t i = 0; i + 2 < xyz.size(); i += 3)
     t.positions.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
+  const std::vector<double> quaternions = u.get_doubles();
+  for (size_t i = 0; i + 3 < quaternions.size(); i += 4)
+    t.orientations.emplace_back(quaternions[i], quaternions[i + 1], quaternions[i + 2],
+                                quaternions[i + 3]);
   return t;
 }
 
@@ -65,6 +73,7 @@ std::vector<char> pack_run(const PrecisionRun& r) {
   p.put<double>(r.rtol);
   p.put<double>(r.atol);
   p.put<double>(r.error);
+  p.put<double>(r.rotation_error);
   p.put<double>(r.stats.wall_seconds);
   p.put<int64_t>(r.stats.steps);
   p.put<int64_t>(r.stats.rhs_evaluations);
@@ -99,6 +108,8 @@ PrecisionRun measure_run(const Study& study, long index, const Trajectory& refer
   out.interrupted = r.result.interrupted;
   out.error = r.result.ok ? trajectory_error(r.trajectory, reference)
                           : std::numeric_limits<double>::quiet_NaN();
+  out.rotation_error = r.result.ok ? trajectory_rotation_error(r.trajectory, reference)
+                                   : std::numeric_limits<double>::quiet_NaN();
   out.stats = r.result.stats;
   out.linear_solver = r.result.linear_solver;
   return out;
@@ -126,7 +137,6 @@ std::vector<char> run_precision_task(const Study* study, const std::vector<char>
   {
     PrecisionRun failed;  // what rank 0 reports as a failed run
     failed.index = index;
-    failed.error = std::numeric_limits<double>::quiet_NaN();
     return pack_run(failed);
   }
 }
@@ -139,6 +149,7 @@ PrecisionRun unpack_precision_run(const std::vector<char>& bytes) {
   r.rtol = u.get<double>();
   r.atol = u.get<double>();
   r.error = u.get<double>();
+  r.rotation_error = u.get<double>();
   r.stats.wall_seconds = u.get<double>();
   r.stats.steps = static_cast<long>(u.get<int64_t>());
   r.stats.rhs_evaluations = static_cast<long>(u.get<int64_t>());

@@ -7,6 +7,8 @@
 // and summary.json; cli/batch_commands.hpp joins the two, prints and returns the exit status.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -24,13 +26,21 @@ struct PrecisionRun {
   long index = 0;  // in plan order: by method, then by rtol
   std::string method;
   double rtol = 0.0, atol = 0.0;
-  double error = std::numeric_limits<double>::quiet_NaN();  // against the reference
+  double error = std::numeric_limits<double>::quiet_NaN();  // centres, against the reference
+  double rotation_error = std::numeric_limits<double>::quiet_NaN();  // orientations, likewise
   SolverStats stats;
   std::string linear_solver;
   bool ok = false, timed_out = false;
   bool interrupted = false;  // cut short by a stop request: not a measurement
   std::string status() const {
     return status_name(ok ? Status::kOk : timed_out ? Status::kTimeout : Status::kFailed);
+  }
+  // The larger of the errors that could be measured (NaN when neither could): what a run is
+  // judged by against the target error, so that a run wrong only in its rotations is not chosen.
+  double larger_error() const {
+    if (std::isnan(error)) return rotation_error;
+    if (std::isnan(rotation_error)) return error;
+    return std::max(error, rotation_error);
   }
 };
 

@@ -152,7 +152,8 @@ int run_work_precision(const Study& study, const RunSettings& settings) {
         measure_work_precision(study, reference, [&](const PrecisionRun& r) {
           if (!settings.quiet)
             std::cerr << r.method << " rtol " << format_number(r.rtol) << ": error "
-                      << format_number(r.error) << ", " << r.stats.wall_seconds << " s ("
+                      << format_number(r.error) << ", rotation error "
+                      << format_number(r.rotation_error) << ", " << r.stats.wall_seconds << " s ("
                       << r.status() << ")\n";
           return table.add(r);
         });

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -304,6 +305,15 @@ TEST_F(MpiRun, AWorkPrecisionStudyOnThreeRanksWritesTheTableOfOneProcess) {
   ASSERT_EQ(expected.size(), 7u);
   ASSERT_EQ(got.size(), expected.size());
   for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], expected[i]) << "row " << i;
+  // The ranks measured rotations too: the orientations of the reference reached them.
+  const size_t rotation = static_cast<size_t>(
+      std::find(expected[0].begin(), expected[0].end(), "rotation_error") - expected[0].begin());
+  ASSERT_LT(rotation, expected[0].size());
+  for (size_t i = 1; i < got.size(); ++i) {
+    ASSERT_LT(rotation, got[i].size());
+    const double e = std::stod(got[i][rotation]);
+    EXPECT_TRUE(std::isfinite(e) && e > 0.0) << "row " << i << ": " << got[i][rotation];
+  }
   const Json one = Json::parse(read_text(dir_ / "alone" / "summary.json"));
   const Json many = Json::parse(read_text(dir_ / "mpi" / "summary.json"));
   EXPECT_EQ(one["ranks"], 1);

@@ -47,7 +47,8 @@ void put_trajectory(Packer& p, const Trajectory& t) {
   p.put_doubles(xyz);
   std::vector<double> quaternions;
   quaternions.reserve(4 * t.orientations.size());
-  for (const Vec4& q : t.orientations) quaternions.insert(quaternions.end(), {q(0), q(1), q(2), q(3)});
+  for (const Vec4& q : t.orientations)
+    quaternions.insert(quaternions.end(), {q(0), q(1), q(2), q(3)});
   p.put_doubles(quaternions);
 }
 

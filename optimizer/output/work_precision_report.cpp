@@ -11,16 +11,16 @@ namespace beamrail {
 
 bool WorkPrecisionTable::open(const std::filesystem::path& output, std::string* error) {
   return table_.open(output / "work_precision.csv",
-                     {"method", "rtol", "atol", "error", "rotation_error", "wall_s", "steps", "rhs_evals",
-                      "jac_evals", "linear_solver", "status"},
+                     {"method", "rtol", "atol", "error", "rotation_error", "wall_s", "steps",
+                      "rhs_evals", "jac_evals", "linear_solver", "status"},
                      error, true);
 }
 
 void WorkPrecisionTable::write(const PrecisionRun& r) {
   table_.row({r.method, format_number(r.rtol), format_number(r.atol), format_number(r.error),
-              format_number(r.rotation_error), format_number(r.stats.wall_seconds), std::to_string(r.stats.steps),
-              std::to_string(r.stats.rhs_evaluations), std::to_string(r.stats.jacobian_evaluations),
-              r.linear_solver, r.status()});
+              format_number(r.rotation_error), format_number(r.stats.wall_seconds),
+              std::to_string(r.stats.steps), std::to_string(r.stats.rhs_evaluations),
+              std::to_string(r.stats.jacobian_evaluations), r.linear_solver, r.status()});
 }
 
 bool WorkPrecisionTable::add(const PrecisionRun& run) {

@@ -34,7 +34,6 @@ using beamrail::testing::raw_fields;
 using beamrail::testing::read_table;
 using beamrail::testing::read_text;
 using beamrail::testing::SameText;
-using beamrail::testing::save_json;
 using beamrail::testing::save_text;
 using beamrail::testing::Table;
 using beamrail::testing::tube_grid;

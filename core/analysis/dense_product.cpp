@@ -1,9 +1,27 @@
 #include "core/analysis/dense_product.hpp"
 
+#include <algorithm>
 #include <cstring>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace beamrail {
 namespace {
+
+thread_local int product_thread_budget = 1;
+
+// The threads for a product of a rows x cols matrix, `parts` being the rows or columns shared out.
+int threads_for(long rows, long cols, long parts) {
+#ifdef _OPENMP
+  if (rows * cols >= kParallelProductSize)
+    return static_cast<int>(std::clamp<long>(parts / 64, 1, product_thread_budget));
+#else
+  (void)rows, (void)cols, (void)parts;
+#endif
+  return 1;
+}
 
 // One pass over the columns of the rows x cols matrix a (8 at a time: y is loaded and stored once
 // per 8 columns) for `kVectors` right-hand sides (x: cols x kVectors, y: rows x kVectors, both
@@ -12,43 +30,46 @@ namespace {
 // fast as before the kernel took rectangles: the braced tower's every-mode run was 8 % slower).
 template <int kVectors, bool kSquare>
 [[gnu::always_inline]] inline void product_kernel(long rows, long cols_given,
-                                                  const double* __restrict a,
-                                                  const double* __restrict x,
-                                                  double* __restrict y) {
+                                                  const double* __restrict a, long lda_given,
+                                                  const double* __restrict x, double* __restrict y,
+                                                  long ldy_given) {
   const long cols = kSquare ? rows : cols_given;
+  const long lda = kSquare ? rows : lda_given;
+  const long ldy = kSquare ? rows : ldy_given;
   constexpr int kBlock = 8;
   if (rows < kBlock && cols < kBlock) {
     // A few modes (a small scene relinearized often): the blocked loops' set-up would dominate.
     for (int v = 0; v < kVectors; ++v)
       for (long i = 0; i < rows; ++i) {
         double s = 0.0;
-        for (long k = 0; k < cols; ++k) s += a[k * rows + i] * x[v * cols + k];
-        y[v * rows + i] = s;
+        for (long k = 0; k < cols; ++k) s += a[k * lda + i] * x[v * cols + k];
+        y[v * ldy + i] = s;
       }
     return;
   }
-  for (long i = 0; i < kVectors * rows; ++i) y[i] = 0.0;
+  for (int v = 0; v < kVectors; ++v)
+    for (long i = 0; i < rows; ++i) y[v * ldy + i] = 0.0;
   long k = 0;
   for (; k + kBlock <= cols; k += kBlock) {
-    const double* col = a + k * rows;
+    const double* col = a + k * lda;
     double p[kVectors][kBlock];
     for (int v = 0; v < kVectors; ++v)
       for (int j = 0; j < kBlock; ++j) p[v][j] = x[v * cols + k + j];
     for (long i = 0; i < rows; ++i) {
       double s[kVectors];
-      for (int v = 0; v < kVectors; ++v) s[v] = y[v * rows + i];
+      for (int v = 0; v < kVectors; ++v) s[v] = y[v * ldy + i];
       for (int j = 0; j < kBlock; ++j) {
-        const double c = col[j * rows + i];
+        const double c = col[j * lda + i];
         for (int v = 0; v < kVectors; ++v) s[v] += p[v][j] * c;
       }
-      for (int v = 0; v < kVectors; ++v) y[v * rows + i] = s[v];
+      for (int v = 0; v < kVectors; ++v) y[v * ldy + i] = s[v];
     }
   }
   for (; k < cols; ++k) {
-    const double* col = a + k * rows;
+    const double* col = a + k * lda;
     for (int v = 0; v < kVectors; ++v) {
       const double p = x[v * cols + k];
-      for (long i = 0; i < rows; ++i) y[v * rows + i] += p * col[i];
+      for (long i = 0; i < rows; ++i) y[v * ldy + i] += p * col[i];
     }
   }
 }
@@ -60,35 +81,37 @@ template <int kVectors, bool kSquare>
 // passes of product_kernel 502 us.
 template <int kVectors>
 [[gnu::always_inline]] inline void wide_kernel(long rows, long cols, const double* __restrict a,
-                                               const double* __restrict x, double* __restrict y) {
+                                               long lda, const double* __restrict x,
+                                               double* __restrict y, long ldy) {
   typedef double Lanes __attribute__((vector_size(64)));
   constexpr int kBlock = 8;
   const long body = rows - rows % 8;
-  for (long i = 0; i < kVectors * rows; ++i) y[i] = 0.0;
+  for (int v = 0; v < kVectors; ++v)
+    for (long i = 0; i < rows; ++i) y[v * ldy + i] = 0.0;
   long k = 0;
   for (; k + kBlock <= cols; k += kBlock) {
     double p[kVectors][kBlock];
     for (int v = 0; v < kVectors; ++v)
       for (int j = 0; j < kBlock; ++j) p[v][j] = x[v * cols + k + j];
-    const double* col = a + k * rows;
+    const double* col = a + k * lda;
     for (long i = 0; i < body; i += 8) {
       Lanes s[kVectors];
-      for (int v = 0; v < kVectors; ++v) std::memcpy(&s[v], y + v * rows + i, sizeof(Lanes));
+      for (int v = 0; v < kVectors; ++v) std::memcpy(&s[v], y + v * ldy + i, sizeof(Lanes));
       for (int j = 0; j < kBlock; ++j) {
         Lanes c;
-        std::memcpy(&c, col + j * rows + i, sizeof c);
+        std::memcpy(&c, col + j * lda + i, sizeof c);
         for (int v = 0; v < kVectors; ++v) s[v] += p[v][j] * c;
       }
-      for (int v = 0; v < kVectors; ++v) std::memcpy(y + v * rows + i, &s[v], sizeof(Lanes));
+      for (int v = 0; v < kVectors; ++v) std::memcpy(y + v * ldy + i, &s[v], sizeof(Lanes));
     }
     for (long i = body; i < rows; ++i)
       for (int j = 0; j < kBlock; ++j)
-        for (int v = 0; v < kVectors; ++v) y[v * rows + i] += p[v][j] * col[j * rows + i];
+        for (int v = 0; v < kVectors; ++v) y[v * ldy + i] += p[v][j] * col[j * lda + i];
   }
   for (; k < cols; ++k)
     for (int v = 0; v < kVectors; ++v) {
       const double p = x[v * cols + k];
-      for (long i = 0; i < rows; ++i) y[v * rows + i] += p * a[k * rows + i];
+      for (long i = 0; i < rows; ++i) y[v * ldy + i] += p * a[k * lda + i];
     }
 }
 
@@ -99,38 +122,94 @@ template <int kVectors>
 #define BEAMRAIL_CLONES
 #endif
 
-BEAMRAIL_CLONES void pair_kernel(long rows, long cols, const double* a, const double* x,
-                                 double* y) {
-  if (rows == cols)
-    product_kernel<2, true>(rows, cols, a, x, y);
+BEAMRAIL_CLONES void pair_kernel(long rows, long cols, const double* a, long lda, const double* x,
+                                 double* y, long ldy) {
+  if (rows == cols && lda == rows && ldy == rows)
+    product_kernel<2, true>(rows, cols, a, lda, x, y, ldy);
   else
-    product_kernel<2, false>(rows, cols, a, x, y);
+    product_kernel<2, false>(rows, cols, a, lda, x, y, ldy);
 }
 
-BEAMRAIL_CLONES void six_kernel(long rows, long cols, const double* a, const double* x, double* y) {
-  wide_kernel<6>(rows, cols, a, x, y);
+BEAMRAIL_CLONES void six_kernel(long rows, long cols, const double* a, long lda, const double* x,
+                                double* y, long ldy) {
+  wide_kernel<6>(rows, cols, a, lda, x, y, ldy);
 }
 
-BEAMRAIL_CLONES void vector_kernel(long rows, long cols, const double* a, const double* x,
-                                   double* y) {
-  if (rows == cols)
-    product_kernel<1, true>(rows, cols, a, x, y);
+BEAMRAIL_CLONES void vector_kernel(long rows, long cols, const double* a, long lda, const double* x,
+                                   double* y, long ldy) {
+  if (rows == cols && lda == rows && ldy == rows)
+    product_kernel<1, true>(rows, cols, a, lda, x, y, ldy);
   else
-    product_kernel<1, false>(rows, cols, a, x, y);
+    product_kernel<1, false>(rows, cols, a, lda, x, y, ldy);
+}
+
+using Kernel = void (*)(long, long, const double*, long, const double*, double*, long);
+
+// The product in row blocks, one per thread, where the matrix is large enough for the threads
+// to pay off and the calling thread's budget has more than one (threads_for).
+void in_row_blocks(Kernel kernel, const Eigen::MatrixXd& a, const double* x, double* y) {
+  const long rows = a.rows(), cols = a.cols();
+  const int threads = threads_for(rows, cols, rows);
+  if (threads <= 1) {
+    kernel(rows, cols, a.data(), rows, x, y, rows);
+    return;
+  }
+#ifdef _OPENMP
+#pragma omp parallel num_threads(threads)
+  {
+    const long n = omp_get_num_threads(), id = omp_get_thread_num();
+    // Blocks of a multiple of 8 rows (the kernels' vector width): their loads stay aligned as
+    // on one thread.
+    const long block = (rows / n + 7) / 8 * 8;
+    const long begin = std::min(rows, id * block);
+    const long end = id + 1 == n ? rows : std::min(rows, begin + block);
+    if (end > begin) kernel(end - begin, cols, a.data() + begin, rows, x, y + begin, rows);
+  }
+#endif
 }
 
 }  // namespace
 
+ProductThreads::ProductThreads(int threads) : previous_(product_thread_budget) {
+  product_thread_budget = std::max(1, threads);
+}
+
+ProductThreads::~ProductThreads() { product_thread_budget = previous_; }
+
+int product_threads() { return product_thread_budget; }
+
 void multiply_pair(const Eigen::MatrixXd& a, const double* x, double* y) {
-  pair_kernel(a.rows(), a.cols(), a.data(), x, y);
+  in_row_blocks(pair_kernel, a, x, y);
 }
 
 void multiply_three_pairs(const Eigen::MatrixXd& a, const double* x, double* y) {
-  six_kernel(a.rows(), a.cols(), a.data(), x, y);
+  in_row_blocks(six_kernel, a, x, y);
 }
 
 void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y) {
-  vector_kernel(a.rows(), a.cols(), a.data(), x, y);
+  in_row_blocks(vector_kernel, a, x, y);
+}
+
+void multiply_transposed(const Eigen::MatrixXd& a, const double* x, double* y) {
+  const long rows = a.rows(), cols = a.cols();
+  const Eigen::Map<const Eigen::VectorXd> v(x, rows);
+  const int threads = threads_for(rows, cols, cols);
+  if (threads <= 1) {
+    Eigen::Map<Eigen::VectorXd>(y, cols).noalias() = a.transpose() * v;
+    return;
+  }
+#ifdef _OPENMP
+#pragma omp parallel num_threads(threads)
+  {
+    const long n = omp_get_num_threads(), id = omp_get_thread_num();
+    const long block = (cols + n - 1) / n;
+    const long begin = std::min(cols, id * block);
+    const long end = std::min(cols, begin + block);
+    if (end > begin)
+      Eigen::Map<Eigen::VectorXd>(y + begin, end - begin).noalias() =
+          a.middleCols(begin, end - begin).transpose() * v;
+  }
+#endif
 }
 
 }  // namespace beamrail

@@ -265,7 +265,7 @@ class ModalExponential : public Integrator {
   // per body; Phi alone is stored and read, so that each stage's passes share one n x m matrix).
   void project(const Eigen::Ref<const Eigen::VectorXd>& v, double* out) {
     m0_v_.noalias() = m0_ * v;
-    Eigen::Map<Eigen::VectorXd>(out, m_).noalias() = phi_.transpose() * m0_v_;
+    multiply_transposed(phi_, m0_v_.data(), out);
   }
 
   // One Newton correction of the quasi-static part: y += R M0 a, with Psi^T a given (psi_a);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <new>
 
+#include "core/analysis/dense_product.hpp"
 #include "core/analysis/stop_request.hpp"
 #include "core/model/element_kinds.hpp"
 #include "optimizer/batch/mpi_job.hpp"
@@ -277,6 +278,13 @@ int run(const RunArguments& args) {
                  "rank 0 alone (the other "
               << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
+  // A run alone (a single run; a work-precision study's runs, timed one after another) shares
+  // its dense products (the modal method's) among the threads a batch of designs would use;
+  // a batch's designs run one per thread, and MPI ranks one run each.
+  const MpiJob* job = mpi_job();
+  const bool alone = (!study->design || study->design->type == DesignStudy::Type::kWorkPrecision) &&
+                     !(job && job->size() > 1);
+  const ProductThreads product_threads(alone ? batch_threads(settings, kMaxThreads) : 1);
   if (study->design) {
     int status = 0;
     switch (study->design->type) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/analysis/dense_product.hpp"
 #include "core/model/element_kinds.hpp"
 #include "optimizer/output/tables.hpp"
 #include "optimizer/output/version.hpp"
@@ -74,6 +75,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
     responses[study.responses[k].name] = json_number(ev.responses[k]);
   s["responses"] = responses;
   s["model"] = model_summary(model);
+  s["product_threads"] = product_threads();  // the modal method's dense products (-j)
   nlohmann::json analyses = nlohmann::json::array();
   for (const AnalysisReport& a : ev.analyses) {
     nlohmann::json j{{"name", a.name},

@@ -331,6 +331,40 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionMeasuresRotationsAndJudgesRunsByThem) {
   EXPECT_EQ(chosen["rtol"], 1e-7);
 }
 
+// A run alone shares the modal method's dense products among the threads -j gives it (all cores
+// by default), and says so in summary.json (product_threads); the run is the same to the bit on
+// one thread. A work-precision study's runs, timed one after another, do the same. The reference
+// problem in 100 segments (a 600 x 600 basis, above the size from which products use threads).
+TEST_F(SpeedAccuracyRuns, ARunAloneSharesItsProductsAmongTheThreadsAskedFor) {
+  Json single = small_work_precision();
+  single.erase("study");
+  single["scene"]["beams"][0]["segments"] = 100;
+  single["analyses"][0]["t_end"] = 0.002;
+  single["analyses"][0]["output_step"] = 5e-4;
+  single["analyses"][0]["integrator"] = Json{{"method", "modal"}, {"rtol", 1e-6}, {"atol", 1e-8}};
+  const fs::path study = write_study("single.json", single);
+  ASSERT_NO_FATAL_FAILURE(run_ok(study, "one", {"-j", "1"}));
+  ASSERT_NO_FATAL_FAILURE(run_ok(study, "two", {"-j", "2"}));
+  const Json one = load_json(dir_ / "one" / "summary.json");
+  const Json two = load_json(dir_ / "two" / "summary.json");
+  EXPECT_EQ(one["product_threads"], 1);
+  EXPECT_EQ(two["product_threads"], 2);
+  EXPECT_EQ(two["analyses"][0]["linear_solver"], "modal");
+  EXPECT_GT(two["analyses"][0]["steps"].get<long>(), 10);
+  EXPECT_EQ(one["analyses"][0]["steps"], two["analyses"][0]["steps"]);
+  const Table a = read_table(dir_ / "one" / "timeseries.csv");
+  const Table b = read_table(dir_ / "two" / "timeseries.csv");
+  ASSERT_EQ(a.rows.size(), 5u);
+  EXPECT_EQ(a.rows, b.rows);
+
+  Json wp = single;
+  wp["analyses"][0].erase("integrator");
+  wp["study"] = Json::parse(R"({"type": "work_precision", "methods": [{"method": "modal"}],
+                                "rtols": [1e-6], "reference": {"method": "modal", "rtol": 1e-9}})");
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp", {"-j", "2"}));
+  EXPECT_EQ(load_json(dir_ / "wp" / "summary.json")["product_threads"], 2);
+}
+
 TEST_F(SpeedAccuracyRuns, ADesignPastItsBudgetIsATimeoutRowAndTheBatchGoesOn) {
   Json s = load_json(kStudies / "work_precision_reference.json");
   s["analyses"][0]["t_end"] = 0.01;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <utility>
 
 namespace beamrail {
@@ -20,10 +21,15 @@ double worst_difference(const Eigen::MatrixXd& a) {
   const Eigen::MatrixXd exact = a * x;
   const Eigen::MatrixXd scale = a.cwiseAbs() * x.cwiseAbs();
   Eigen::MatrixXd pair(rows, 2), six(rows, 6);
-  Eigen::VectorXd one(rows);
+  Eigen::VectorXd one(rows), transposed(cols);
   multiply_pair(a, x.data(), pair.data());
   multiply_vector(a, x.col(1).data(), one.data());
   multiply_three_pairs(a, x.data(), six.data());
+  // a^T u for u = the first column of a x (rows long).
+  const Eigen::VectorXd u = exact.col(0) / exact.col(0).cwiseAbs().maxCoeff();
+  multiply_transposed(a, u.data(), transposed.data());
+  const Eigen::VectorXd transposed_exact = a.transpose() * u;
+  const Eigen::VectorXd transposed_scale = a.cwiseAbs().transpose() * u.cwiseAbs();
   double worst = 0.0;
   const double bound = 4 * cols * 1.2e-16;
   auto check = [&](double value, Eigen::Index i, int c, const char* kernel) {
@@ -36,6 +42,11 @@ double worst_difference(const Eigen::MatrixXd& a) {
     for (int c = 0; c < 2; ++c) check(pair(i, c), i, c, "pair");
     check(one(i), i, 1, "vector");
     for (int c = 0; c < 6; ++c) check(six(i, c), i, c, "three pairs");
+  }
+  for (Eigen::Index j = 0; j < cols; ++j) {
+    const double e = std::abs(transposed(j) - transposed_exact(j)) / transposed_scale(j);
+    worst = std::max(worst, e);
+    EXPECT_LT(e, 4 * rows * 1.2e-16) << rows << " x " << cols << " column " << j << " (transposed)";
   }
   return worst;
 }
@@ -65,6 +76,46 @@ TEST(DenseProduct, RectangularMatchesEigen) {
     worst = std::max(worst, worst_difference(Eigen::MatrixXd::Random(rows, cols)));
   std::printf("rectangular products vs Eigen: worst difference %.2e of the rounding scale\n",
               worst);
+}
+
+// With a budget of threads (ProductThreads) the products above kParallelProductSize entries are
+// shared out in blocks of rows (of columns for a^T x), and every entry is summed in the same
+// order: the same bits as on one thread, for 2 and 3 threads (3 leaves uneven blocks), on the
+// braced tower's square basis, a band's tall one and its transpose's shape, and at the threshold.
+TEST(DenseProduct, ThreadsGiveTheSameBits) {
+  for (auto [rows, cols] : {std::pair{1038, 1038}, {6000, 95}, {95, 6000}, {363, 362}}) {
+    ASSERT_GE(static_cast<long>(rows) * cols, kParallelProductSize);
+    const Eigen::MatrixXd a = Eigen::MatrixXd::Random(rows, cols);
+    const Eigen::MatrixXd x = Eigen::MatrixXd::Random(cols, 6);
+    const Eigen::VectorXd u = Eigen::VectorXd::Random(rows);
+    struct Products {
+      Eigen::MatrixXd pair, six;
+      Eigen::VectorXd one, transposed;
+    };
+    auto products = [&](int threads) {
+      const ProductThreads budget(threads);
+      EXPECT_EQ(product_threads(), threads);
+      Products p{Eigen::MatrixXd(rows, 2), Eigen::MatrixXd(rows, 6), Eigen::VectorXd(rows),
+                 Eigen::VectorXd(cols)};
+      multiply_pair(a, x.data(), p.pair.data());
+      multiply_three_pairs(a, x.data(), p.six.data());
+      multiply_vector(a, x.data(), p.one.data());
+      multiply_transposed(a, u.data(), p.transposed.data());
+      return p;
+    };
+    const Products serial = products(1);
+    EXPECT_LT((serial.six - a * x).cwiseAbs().maxCoeff(), 1e-12 * cols);
+    for (int threads : {2, 3}) {
+      const Products shared = products(threads);
+      const std::string label = std::to_string(rows) + " x " + std::to_string(cols) + ", " +
+                                std::to_string(threads) + " threads";
+      EXPECT_TRUE(shared.pair == serial.pair) << label << " (pair)";
+      EXPECT_TRUE(shared.six == serial.six) << label << " (three pairs)";
+      EXPECT_TRUE(shared.one == serial.one) << label << " (vector)";
+      EXPECT_TRUE(shared.transposed == serial.transposed) << label << " (transposed)";
+    }
+  }
+  EXPECT_EQ(product_threads(), 1);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "core/analysis/dense_product.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 
 #ifdef _OPENMP
@@ -11,6 +12,17 @@ namespace beamrail {
 namespace {
 
 thread_local int product_thread_budget = 1;
+std::atomic<long> products_shared{0};
+std::atomic<int> largest_team{1};
+
+// Counts a product that ran on a team of n threads (called by one of them).
+void count_team(long n) {
+  if (n <= 1) return;
+  ++products_shared;
+  int seen = largest_team.load();
+  while (seen < n && !largest_team.compare_exchange_weak(seen, static_cast<int>(n))) {
+  }
+}
 
 // The threads for a product of a rows x cols matrix, `parts` being the rows or columns shared out.
 int threads_for(long rows, long cols, long parts) {
@@ -158,6 +170,7 @@ void in_row_blocks(Kernel kernel, const Eigen::MatrixXd& a, const double* x, dou
 #pragma omp parallel num_threads(threads)
   {
     const long n = omp_get_num_threads(), id = omp_get_thread_num();
+    if (id == 0) count_team(n);
     // Blocks of a multiple of 8 rows (the kernels' vector width): their loads stay aligned as
     // on one thread.
     const long block = (rows / n + 7) / 8 * 8;
@@ -202,14 +215,27 @@ void multiply_transposed(const Eigen::MatrixXd& a, const double* x, double* y) {
 #pragma omp parallel num_threads(threads)
   {
     const long n = omp_get_num_threads(), id = omp_get_thread_num();
-    const long block = (cols + n - 1) / n;
-    const long begin = std::min(cols, id * block);
-    const long end = std::min(cols, begin + block);
+    if (id == 0) count_team(n);
+    // Eigen's product takes the columns 8, 4, 2 and 1 at a time, and sums a column's last rows
+    // in another order in its one-column loop than in the others when vectorized for AVX (and
+    // a one-column block becomes a dot product): blocks that start at multiples of 8 columns,
+    // the last one at least 8 long, put every column in the loop it has on one thread, so the
+    // bits do not move.
+    const long block = ((cols + n - 1) / n + 7) / 8 * 8;
+    const auto bound = [&](long k) {
+      const long b = std::min(cols, k * block);
+      return cols - b < 8 ? cols : b;
+    };
+    const long begin = bound(id), end = id + 1 == n ? cols : bound(id + 1);
     if (end > begin)
       Eigen::Map<Eigen::VectorXd>(y + begin, end - begin).noalias() =
           a.middleCols(begin, end - begin).transpose() * v;
   }
 #endif
 }
+
+long products_on_threads() { return products_shared.load(); }
+
+int largest_product_team() { return largest_team.load(); }
 
 }  // namespace beamrail

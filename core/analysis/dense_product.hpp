@@ -11,8 +11,8 @@
 // Threads: a matrix of at least kParallelProductSize entries is multiplied in blocks of rows (of
 // columns for a^T x), one per thread of the calling thread's budget (ProductThreads; 1 unless a
 // caller sets it: a single run gets the cores a batch of designs would use, a run inside a batch
-// keeps 1). Each entry is summed in the same order whatever the threads: the results are the same
-// to the bit.
+// keeps 1), at most one per 64 rows (columns) shared. Each entry is summed in the same order
+// whatever the threads: the results are the same to the bit.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,6 +37,12 @@ class ProductThreads {
 
 // The calling thread's budget.
 int product_threads();
+
+// How many products (of any thread) have run on more than one thread since the program started.
+long products_on_threads();
+
+// The most threads one product has run on since the program started (1 when none was shared).
+int largest_product_team();
 
 // y = a x for the column-major arrays x (a.cols() x 2) and y (a.rows() x 2): two vectors side by
 // side.

@@ -1,5 +1,6 @@
 #include "optimizer/cli/cli.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -278,13 +279,19 @@ int run(const RunArguments& args) {
                  "rank 0 alone (the other "
               << job->size() - 1 << " wait)\n";
   const RunSettings settings{out, args.threads, args.resume, args.quiet, command_line(args, out)};
-  // A run alone (a single run; a work-precision study's runs, timed one after another) shares
-  // its dense products (the modal method's) among the threads a batch of designs would use;
-  // a batch's designs run one per thread, and MPI ranks one run each.
+  // A single run shares its dense products (the modal method's) among the threads a batch of
+  // designs would use (-j, default all cores); a work-precision study's runs, timed one after
+  // another, only among those -j names (by default every method is timed on one thread). A
+  // batch's designs run one per thread, and MPI ranks one run each.
   const MpiJob* job = mpi_job();
-  const bool alone = (!study->design || study->design->type == DesignStudy::Type::kWorkPrecision) &&
-                     !(job && job->size() > 1);
-  const ProductThreads product_threads(alone ? batch_threads(settings, kMaxThreads) : 1);
+  int product_budget = 1;
+  if (!(job && job->size() > 1)) {
+    if (!study->design)
+      product_budget = batch_threads(settings, kMaxThreads);
+    else if (study->design->type == DesignStudy::Type::kWorkPrecision)
+      product_budget = std::max(1, args.threads);
+  }
+  const ProductThreads product_threads(product_budget);
   if (study->design) {
     int status = 0;
     switch (study->design->type) {

@@ -75,7 +75,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
     responses[study.responses[k].name] = json_number(ev.responses[k]);
   s["responses"] = responses;
   s["model"] = model_summary(model);
-  s["product_threads"] = product_threads();  // the modal method's dense products (-j)
+  s["product_threads"] = largest_product_team();  // the modal method's dense products
   nlohmann::json analyses = nlohmann::json::array();
   for (const AnalysisReport& a : ev.analyses) {
     nlohmann::json j{{"name", a.name},

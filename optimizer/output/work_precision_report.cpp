@@ -138,7 +138,7 @@ WorkPrecisionReport report_work_precision(const Study& study, const RunSettings&
       "angle a body turned in the reference run (nan when none turns more than 1e-9 rad); a run "
       "is within the target when both errors that could be measured are";
   summary["ranks"] = result.ranks;
-  summary["product_threads"] = product_threads();  // the runs' dense products (-j)
+  summary["product_threads"] = largest_product_team();  // the runs' dense products
   if (result.ranks > 1) summary["runs_per_rank"] = result.runs_per_rank;
   RunOutcome& outcome = report.outcome;
   if (!table_error.empty()) {

@@ -331,10 +331,11 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionMeasuresRotationsAndJudgesRunsByThem) {
   EXPECT_EQ(chosen["rtol"], 1e-7);
 }
 
-// A run alone shares the modal method's dense products among the threads -j gives it (all cores
-// by default), and says so in summary.json (product_threads); the run is the same to the bit on
-// one thread. A work-precision study's runs, timed one after another, do the same. The reference
-// problem in 100 segments (a 600 x 600 basis, above the size from which products use threads).
+// A single run shares the modal method's dense products among the threads -j gives it (all cores
+// by default), and says in summary.json how many they ran on (product_threads); the run is the
+// same to the bit on one thread. A work-precision study's runs, timed one after another, do the
+// same when -j asks for it. The reference problem in 100 segments (a 600 x 600 basis, above the
+// size from which products use threads).
 TEST_F(SpeedAccuracyRuns, ARunAloneSharesItsProductsAmongTheThreadsAskedFor) {
   Json single = small_work_precision();
   single.erase("study");
@@ -363,6 +364,13 @@ TEST_F(SpeedAccuracyRuns, ARunAloneSharesItsProductsAmongTheThreadsAskedFor) {
                                 "rtols": [1e-6], "reference": {"method": "modal", "rtol": 1e-9}})");
   ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp", {"-j", "2"}));
   EXPECT_EQ(load_json(dir_ / "wp" / "summary.json")["product_threads"], 2);
+  // Without -j a work-precision study times every method on one thread.
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", wp), "wp_default"));
+  EXPECT_EQ(load_json(dir_ / "wp_default" / "summary.json")["product_threads"], 1);
+  // A method without dense products uses none.
+  single["analyses"][0]["integrator"]["method"] = "bdf";
+  ASSERT_NO_FATAL_FAILURE(run_ok(write_study("bdf.json", single), "bdf", {"-j", "2"}));
+  EXPECT_EQ(load_json(dir_ / "bdf" / "summary.json")["product_threads"], 1);
 }
 
 TEST_F(SpeedAccuracyRuns, ADesignPastItsBudgetIsATimeoutRowAndTheBatchGoesOn) {

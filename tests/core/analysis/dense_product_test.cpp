@@ -79,11 +79,20 @@ TEST(DenseProduct, RectangularMatchesEigen) {
 }
 
 // With a budget of threads (ProductThreads) the products above kParallelProductSize entries are
-// shared out in blocks of rows (of columns for a^T x), and every entry is summed in the same
-// order: the same bits as on one thread, for 2 and 3 threads (3 leaves uneven blocks), on the
-// braced tower's square basis, a band's tall one and its transpose's shape, and at the threshold.
+// shared out in blocks of rows (of columns for a^T x), at most one thread per 64 of them, and
+// every entry is summed in the same order: the same bits as on one thread, for 2 and 3 threads
+// (3 leaves uneven blocks), on the braced tower's square basis, at the threshold, and on a
+// band's tall basis (6000 x 95: its rows shared, its transposed product on one thread, 95
+// columns) and its transpose's shape (95 x 6000: the transposed product shared). That the
+// threads ran is counted (products_on_threads).
 TEST(DenseProduct, ThreadsGiveTheSameBits) {
-  for (auto [rows, cols] : {std::pair{1038, 1038}, {6000, 95}, {95, 6000}, {363, 362}}) {
+  struct Shape {
+    int rows, cols;
+    bool rows_shared, columns_shared;
+  };
+  for (const Shape& shape : {Shape{1038, 1038, true, true}, Shape{363, 362, true, true},
+                             Shape{6000, 95, true, false}, Shape{95, 6000, false, true}}) {
+    const int rows = shape.rows, cols = shape.cols;
     ASSERT_GE(static_cast<long>(rows) * cols, kParallelProductSize);
     const Eigen::MatrixXd a = Eigen::MatrixXd::Random(rows, cols);
     const Eigen::MatrixXd x = Eigen::MatrixXd::Random(cols, 6);
@@ -91,24 +100,29 @@ TEST(DenseProduct, ThreadsGiveTheSameBits) {
     struct Products {
       Eigen::MatrixXd pair, six;
       Eigen::VectorXd one, transposed;
+      long shared = 0;  // products that ran on more than one thread
     };
     auto products = [&](int threads) {
       const ProductThreads budget(threads);
       EXPECT_EQ(product_threads(), threads);
       Products p{Eigen::MatrixXd(rows, 2), Eigen::MatrixXd(rows, 6), Eigen::VectorXd(rows),
                  Eigen::VectorXd(cols)};
+      const long before = products_on_threads();
       multiply_pair(a, x.data(), p.pair.data());
       multiply_three_pairs(a, x.data(), p.six.data());
       multiply_vector(a, x.data(), p.one.data());
       multiply_transposed(a, u.data(), p.transposed.data());
+      p.shared = products_on_threads() - before;
       return p;
     };
     const Products serial = products(1);
+    EXPECT_EQ(serial.shared, 0);
     EXPECT_LT((serial.six - a * x).cwiseAbs().maxCoeff(), 1e-12 * cols);
     for (int threads : {2, 3}) {
       const Products shared = products(threads);
       const std::string label = std::to_string(rows) + " x " + std::to_string(cols) + ", " +
                                 std::to_string(threads) + " threads";
+      EXPECT_EQ(shared.shared, 3 * shape.rows_shared + shape.columns_shared) << label;
       EXPECT_TRUE(shared.pair == serial.pair) << label << " (pair)";
       EXPECT_TRUE(shared.six == serial.six) << label << " (three pairs)";
       EXPECT_TRUE(shared.one == serial.one) << label << " (vector)";

@@ -171,10 +171,13 @@ TEST(ModalIntegrator, TwoThreadsGiveTheSameRunToTheBit) {
   ASSERT_GE(model.n_dofs * model.n_dofs, kParallelProductSize);
   const TransientRun one = simulate(model, modal(0.002, 5e-4, 1e-6, 1e-8));
   TransientRun two;
+  const long shared_before = products_on_threads();
   {
     const ProductThreads threads(2);
     two = simulate(model, modal(0.002, 5e-4, 1e-6, 1e-8));
   }
+  // Every product of the run's steps was shared (about ten a step).
+  EXPECT_GT(products_on_threads() - shared_before, 10 * two.result.stats.steps);
   EXPECT_EQ(product_threads(), 1);  // restored
   ASSERT_TRUE(one.result.ok && two.result.ok) << one.result.message << two.result.message;
   EXPECT_GT(one.result.stats.steps, 10);

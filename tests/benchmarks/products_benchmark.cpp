@@ -11,24 +11,15 @@
 namespace beamrail {
 namespace {
 
-void Pair(benchmark::State& state) {
+// y = a x for kVectors right-hand sides by `multiply` (multiply_pair or multiply_three_pairs).
+template <int kVectors, void (*multiply)(const Eigen::MatrixXd&, const double*, double*)>
+void Columns(benchmark::State& state) {
   const Eigen::MatrixXd a = Eigen::MatrixXd::Random(state.range(0), state.range(1));
-  const Eigen::MatrixXd x = Eigen::MatrixXd::Random(a.cols(), 2);
-  Eigen::MatrixXd y(a.rows(), 2);
+  const Eigen::MatrixXd x = Eigen::MatrixXd::Random(a.cols(), kVectors);
+  Eigen::MatrixXd y(a.rows(), kVectors);
   const ProductThreads threads(static_cast<int>(state.range(2)));
   for (auto _ : state) {
-    multiply_pair(a, x.data(), y.data());
-    benchmark::DoNotOptimize(y.data());
-  }
-}
-
-void ThreePairs(benchmark::State& state) {
-  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(state.range(0), state.range(1));
-  const Eigen::MatrixXd x = Eigen::MatrixXd::Random(a.cols(), 6);
-  Eigen::MatrixXd y(a.rows(), 6);
-  const ProductThreads threads(static_cast<int>(state.range(2)));
-  for (auto _ : state) {
-    multiply_three_pairs(a, x.data(), y.data());
+    multiply(a, x.data(), y.data());
     benchmark::DoNotOptimize(y.data());
   }
 }
@@ -50,8 +41,8 @@ void Sizes(benchmark::internal::Benchmark* b) {
   b->UseRealTime();
 }
 
-BENCHMARK(Pair)->Apply(Sizes);
-BENCHMARK(ThreePairs)->Apply(Sizes);
+BENCHMARK(Columns<2, multiply_pair>)->Name("Pair")->Apply(Sizes);
+BENCHMARK(Columns<6, multiply_three_pairs>)->Name("ThreePairs")->Apply(Sizes);
 BENCHMARK(Transposed)->Apply(Sizes);
 
 }  // namespace

@@ -10,15 +10,42 @@
 
 namespace beamrail {
 
-bool write_all(int fd, const std::string& text) {
+bool write_all(int fd, const char* text, size_t size) {
   size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+  while (done < size) {
+    const ssize_t n = ::write(fd, text + done, size - done);
     if (n < 0) {
       if (errno == EINTR) continue;
       return false;
     }
     done += static_cast<size_t>(n);
+  }
+  return true;
+}
+
+bool write_all(int fd, const std::string& text) { return write_all(fd, text.data(), text.size()); }
+
+// A process killed outright (SIGKILL) can stop a write between two pages of the file (Linux
+// checks for a fatal signal before it copies each page), which cut a row in
+// ResultsFolder.AKilledSingleRunLeavesItsRowsOnDisk once in CI: hence pieces within a page. A
+// row longer than a page is written whole in one piece, and can still be cut.
+bool write_rows(int fd, const std::string& text, off_t offset) {
+  constexpr size_t kPage = 4096;
+  size_t done = 0;
+  while (done < text.size()) {
+    const size_t page_end = done + (kPage - static_cast<size_t>(offset + done) % kPage);
+    size_t end = text.size();
+    if (page_end < text.size()) {
+      const size_t last = text.rfind('\n', page_end - 1);
+      if (last != std::string::npos && last >= done) {
+        end = last + 1;
+      } else {
+        const size_t next = text.find('\n', page_end);
+        if (next != std::string::npos) end = next + 1;
+      }
+    }
+    if (!write_all(fd, text.data() + done, end - done)) return false;
+    done = end;
   }
   return true;
 }
@@ -101,7 +128,7 @@ bool CsvWriter::flush(bool sync) {
     return false;
   }
   if (!buffer_.empty()) {
-    if (write_all(fd_, buffer_)) {
+    if (write_rows(fd_, buffer_, written_)) {
       written_ += static_cast<off_t>(buffer_.size());
     } else {
       fail("cannot write");

@@ -15,8 +15,14 @@ namespace beamrail {
 // error (errno says which).
 bool write_all(int fd, const std::string& text);
 
+// Writes the whole rows `text` (each ending in '\n') to fd, whose file offset is `offset`, in
+// pieces that end at a row's end and stay within one 4 KiB page of the file where a row fits: a
+// process killed outright can stop a write between pages, never within one. False on an error.
+bool write_rows(int fd, const std::string& text, off_t offset);
+
 // A CSV table appended one whole row at a time. Rows are buffered and handed to the operating
-// system in single write calls that end at a row boundary, so a killed process leaves whole rows;
+// system in write calls that end at a row boundary (write_rows), so a killed process leaves whole
+// rows;
 // after a write error (disk full, file-size limit) the rows written in part are cut off again, the
 // table takes no more rows, and error() names the file and the system's reason.
 //

@@ -42,6 +42,7 @@ using testing::load_json;
 using testing::Process;
 using testing::ProcessResult;
 using testing::read_text;
+using testing::save_text;
 
 const fs::path kStudies = BEAMRAIL_STUDIES_DIR;
 
@@ -395,7 +396,8 @@ TEST_F(ResultsFolder, AnInterruptedSingleRunMarksTheFolderAndKeepsItsRows) {
 }
 
 // A run killed outright (SIGKILL: no handler runs) still leaves the rows of the last second on
-// the disk, and summary.json saying the folder is incomplete.
+// the disk, whole but perhaps for the last line, and summary.json saying the folder is
+// incomplete.
 TEST_F(ResultsFolder, AKilledSingleRunLeavesItsRowsOnDisk) {
   const fs::path study = write_study("long.json", long_transient());
   const fs::path partial = dir_ / "out" / "timeseries.csv.partial";
@@ -405,8 +407,14 @@ TEST_F(ResultsFolder, AKilledSingleRunLeavesItsRowsOnDisk) {
   p.kill(SIGKILL);
   p.wait(std::chrono::seconds(60));
   EXPECT_TRUE(rows_seen) << "no time series row reached the disk within 8 s";
+  // The kill can stop the write of the one row that crosses a page of the file between its two
+  // pages (write_rows; it did once in CI when rows went 64 KiB at a time): an unfinished last
+  // line is dropped, as --resume drops one, and every row before it is whole.
+  std::string text = read_text(partial);
+  if (!text.empty() && text.back() != '\n') text.erase(text.rfind('\n') + 1);
+  save_text(dir_ / "whole_rows.csv", text);
   size_t rows = 0;
-  ASSERT_TRUE(WholeRows(partial, &rows));
+  ASSERT_TRUE(WholeRows(dir_ / "whole_rows.csv", &rows));
   EXPECT_GE(rows, 2u);
   EXPECT_EQ(load_json(dir_ / "out" / "summary.json")["status"], "running");
 }

@@ -42,6 +42,13 @@ inline Vec4 quat_multiply(const Vec4& a, const Vec4& b) {
   return r;
 }
 
+// The angle of the rotation from orientation a to orientation b [rad, 0 .. pi]: Euler parameters of
+// either sign and any norm (2 atan2(|vec r|, |r0|), r = conj(a) (x) b, accurate at small angles).
+inline double rotation_angle_between(const Vec4& a, const Vec4& b) {
+  const Vec4 r = quat_multiply(Vec4(a(0), -a(1), -a(2), -a(3)), b);
+  return 2.0 * std::atan2(r.tail<3>().norm(), std::abs(r(0)));
+}
+
 // Euler parameters of the rotation exp([theta]x) (angle |theta| about theta/|theta|).
 inline Vec4 quat_from_rotation_vector(const Vec3& theta) {
   const double angle = theta.norm();

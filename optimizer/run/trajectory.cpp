@@ -61,13 +61,8 @@ double trajectory_error(const Trajectory& run, const Trajectory& reference) {
 }
 
 double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference) {
-  // The angle of the rotation from a to b (Euler parameters, either sign, any norm).
-  const auto angle = [](const Vec4& a, const Vec4& b) {
-    const Vec4 r = quat_multiply(Vec4(a(0), -a(1), -a(2), -a(3)), b);
-    return 2.0 * std::atan2(r.tail<3>().norm(), std::abs(r(0)));
-  };
-  return relative_error(run, reference, run.orientations, reference.orientations, angle,
-                        kLeastTurn);
+  return relative_error(run, reference, run.orientations, reference.orientations,
+                        rotation_angle_between, kLeastTurn);
 }
 
 }  // namespace beamrail

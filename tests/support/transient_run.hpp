@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/analysis/transient.hpp"
+#include "core/model/rotation.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace beamrail::testing {
@@ -73,17 +74,14 @@ inline double run_error(const Model& model, const TransientRun& run,
 // the largest angle a body turned in the reference (work_precision.csv's rotation_error).
 inline double run_rotation_error(const Model& model, const TransientRun& run,
                                  const TransientRun& reference) {
-  const auto angle = [](const Vec4& a, const Vec4& b) {
-    const Vec4 r = quat_multiply(Vec4(a(0), -a(1), -a(2), -a(3)), b);
-    return 2.0 * std::atan2(r.tail<3>().norm(), std::abs(r(0)));
-  };
   double error = 0.0, turn = 0.0;
   const size_t n = std::min(run.samples.size(), reference.samples.size());
   for (int b : model.free_bodies) {
     for (const auto& s : reference.samples)
-      turn = std::max(turn, angle(s.q[b], reference.samples.front().q[b]));
+      turn = std::max(turn, rotation_angle_between(s.q[b], reference.samples.front().q[b]));
     for (size_t k = 0; k < n; ++k)
-      error = std::max(error, angle(run.samples[k].q[b], reference.samples[k].q[b]));
+      error =
+          std::max(error, rotation_angle_between(run.samples[k].q[b], reference.samples[k].q[b]));
   }
   return error / turn;
 }

@@ -39,6 +39,23 @@ TEST(Rotation, RoundTripsThroughMatrixAndRotationVector) {
   }
 }
 
+// The angle between a and a (x) exp(theta) is |theta| whatever the signs and norms of the Euler
+// parameters, to rounding also at a nanoradian (where 2 acos(r0) would lose every digit).
+TEST(Rotation, AngleBetweenOrientationsIsTheRelativeTurn) {
+  testing::Random rng(3);
+  for (double size : {1e-9, 1e-4, 0.5, 3.0}) {
+    for (int i = 0; i < 20; ++i) {
+      const Vec4 a = quat_from_rotation_matrix(rng.rotation());
+      Vec3 theta = rng.vec3(1.0);
+      theta *= size / theta.norm();
+      const Vec4 b = quat_multiply(a, quat_from_rotation_vector(theta));
+      EXPECT_NEAR(rotation_angle_between(a, b), size, 1e-15 + 4e-15 * size);
+      EXPECT_NEAR(rotation_angle_between(-2.0 * a, 0.5 * b), size, 1e-15 + 4e-15 * size);
+      EXPECT_NEAR(rotation_angle_between(b, a), size, 1e-15 + 4e-15 * size);
+    }
+  }
+}
+
 TEST(Rotation, IncrementJacobianMatchesFiniteDifferences) {
   testing::Random rng(3);
   for (int i = 0; i < 50; ++i) {

@@ -109,6 +109,18 @@ class AutoIntegrator : public Integrator {
   int advance(double tout, double tstop, N_Vector y, double* t) override {
     for (;;) {
       const int flag = current_->advance(tout, tstop, y, t);
+      if (modal_ && (flag == kModalStepTooSmall || flag == kModalNonFinite) &&
+          !context_->timed_out && !context_->interrupted && context_->callback_error.empty()) {
+        // The modal method failed where an implicit one may not (a motion too far from the
+        // linearization for its explicit remainder, a band's quasi-static iteration that does
+        // not converge): the run goes on from the last accepted state, and says why.
+        before_ = sum(before_, current_->stats());
+        std::string error;
+        if (!start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
+                            "the modal method failed (" + current_->failure(flag) + ")", &error))
+          return fail(error);
+        continue;
+      }
       if (flag != kModalTooFar || !modal_) return flag;
       const std::string who = quoted(current_->failure(flag));
       const long steps = current_->stats().steps;
@@ -151,6 +163,7 @@ class AutoIntegrator : public Integrator {
       }
       next->restart(*t, y);
       band_hz = std::max(band_hz, next->band_hz);
+      absorb_inertia();
       current_ = std::move(next);
       record(*t, "modal",
              "body " + who + " turned " + number(turned) +
@@ -166,6 +179,14 @@ class AutoIntegrator : public Integrator {
   std::string failure(int flag) const override {
     if (flag == kAutoFailed) return failure_;
     return current_->failure(flag);
+  }
+
+  // The dropped inertia of the band-limited modal phases: their drifts add up.
+  std::vector<std::string> closing_warnings() const override {
+    QuasiStaticInertia q = inertia_;
+    if (QuasiStaticInertia now; modal_quasi_static_inertia(*current_, &now)) add(q, now);
+    if (!(q.drift > options_.rtol)) return {};
+    return {quasi_static_inertia_warning(q)};
   }
 
   std::vector<MethodPhase> phases(long* count) const override {
@@ -188,6 +209,18 @@ class AutoIntegrator : public Integrator {
     return m;
   }
 
+  static void add(QuasiStaticInertia& sum, const QuasiStaticInertia& phase) {
+    sum.band_hz = std::max(sum.band_hz, phase.band_hz);
+    sum.ratio = std::max(sum.ratio, phase.ratio);
+    sum.drift += phase.drift;
+    sum.t = phase.t;
+  }
+
+  // Keeps what the current phase dropped before it ends.
+  void absorb_inertia() {
+    if (QuasiStaticInertia q; modal_quasi_static_inertia(*current_, &q)) add(inertia_, q);
+  }
+
   int fail(const std::string& why) {
     failure_ = why;
     return kAutoFailed;
@@ -207,6 +240,7 @@ class AutoIntegrator : public Integrator {
     std::unique_ptr<Integrator> next = make_integrator(o, *context_, sunctx_, y, error);
     if (!next) return false;
     if (t > 0.0) next->restart(t, y);
+    if (current_) absorb_inertia();
     for (const std::string& w : next->warnings) warnings.push_back(w);
     current_ = std::move(next);
     modal_ = false;
@@ -236,7 +270,8 @@ class AutoIntegrator : public Integrator {
   double rotation_limit_ = kAutoRelinearizeRotation;     // of the current linearization [rad]
   double smallest_limit_ = kAutoMinRelinearizeRotation;  // the limit halves down to this
   SolverStats before_;                                   // of the phases before the current one
-  std::string failure_;                                  // why auto itself failed (kAutoFailed)
+  QuasiStaticInertia inertia_;  // the dropped inertia of the modal phases before the current one
+  std::string failure_;         // why auto itself failed (kAutoFailed)
   std::vector<MethodPhase> first_;
   MethodPhase last_;
   long count_ = 0;

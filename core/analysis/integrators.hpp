@@ -28,6 +28,9 @@ class Integrator {
   std::string linear_solver = "none";
   long nnz = 0;                       // stored Jacobian entries (sparse)
   std::vector<std::string> warnings;  // for the run's result (set up at construction)
+  // Warnings that only the whole run can tell (a band-limited modal run's dropped inertia), asked
+  // for at its end.
+  virtual std::vector<std::string> closing_warnings() const { return {}; }
   // The highest frequency a band-limited modal method integrated [Hz], given or chosen (auto: the
   // highest of its modal phases); 0 when every mode was integrated or the method has no band.
   double band_hz = 0.0;

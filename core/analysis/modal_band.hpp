@@ -33,7 +33,9 @@
 // velocity's motion is its modes' linear response at 32 times up to the horizon (a 201-body
 // cantilever run for 10 ms, a twelfth of its period, chose bands that left 11 rtol of its own
 // motion; tests/core/analysis/transient_auto_test.cpp); a smooth load's is not reduced. The
-// nonlinear forcing is not in it: the modal method is for motions near its linearization. The band
+// nonlinear forcing is not in it: the modal method is for motions near its linearization (what
+// the quasi-static modes then miss, their inertia, is checked during the run:
+// core/analysis/modal_integrator.cpp, check_quasi_static_inertia). The band
 // is the smallest number of modes (never splitting a cluster of equal frequencies, never leaving
 // out a rigid or mechanism mode) whose estimate is at most the tolerance. An estimate, not a bound:
 // on a cantilever (tests/core/analysis/modal_band_test.cpp) the bands chosen for rtol 1e-3 .. 1e-6

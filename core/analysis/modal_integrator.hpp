@@ -62,6 +62,11 @@ inline constexpr double kModalIntegratorMaxRotation = 1.0;
 // The flag of a run stopped because a body turned more than the rotation limit from the
 // orientation it is linearized about (y and t then hold the last accepted state).
 inline constexpr int kModalTooFar = -20;
+// The flags of a run stopped because its step fell below the roundoff of the time, and because
+// the forces of a trial state were not finite ten times running (y and t: the last accepted
+// state).
+inline constexpr int kModalStepTooSmall = -3;
+inline constexpr int kModalNonFinite = -8;
 
 // The eigenvalues w^2 of a modal integrator's linearization: the smallest positive one and the
 // largest [1/s^2]. False when `integrator` is not a modal integrator.
@@ -70,6 +75,19 @@ bool modal_spectrum(const Integrator& integrator, double* smallest_positive, dou
 // How a modal integrator chose its band ("band 812 Hz: 40 of 5,994 modes, ..."); "" when it was
 // given or the integrator is not modal.
 std::string modal_band_choice(const Integrator& integrator);
+
+// What a band-limited modal run drops with the kinetic energy of the modes it keeps
+// quasi-static (core/analysis/modal_integrator.cpp, check_quasi_static_inertia).
+struct QuasiStaticInertia {
+  double band_hz = 0.0;  // the band's top [Hz]
+  double ratio = 0.0;    // their largest kinetic energy over the band's largest
+  double drift = 0.0;    // the error that leaves, estimated, relative to the motion
+  double t = 0.0;        // up to this time [s]
+};
+// Of a modal integrator's run so far; false when it is not a band-limited modal integrator.
+bool modal_quasi_static_inertia(const Integrator& integrator, QuasiStaticInertia* out);
+// The run's warning for a drift above rtol.
+std::string quasi_static_inertia_warning(const QuasiStaticInertia& inertia);
 
 // The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
 double modal_step_size(const Integrator& integrator);

@@ -255,6 +255,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     for (const std::string& w : integrator->warnings)  // auto's arrive during the run
       if (std::find(result.warnings.begin(), result.warnings.end(), w) == result.warnings.end())
         result.warnings.push_back(w);
+    for (std::string& w : integrator->closing_warnings()) result.warnings.push_back(std::move(w));
   } catch (const std::exception& e) {
     result.ok = false;
     result.message = e.what();

@@ -609,20 +609,18 @@ class ModalExponential : public Integrator {
   // A band-limited run drops the kinetic energy of its quasi-static part y (their dynamics):
   // what the linear estimate of the band (modal_band.hpp) leaves out is the part the motion
   // drives at second order, a stiff mode pulled along by the deflection (a heavy tip's axial
-  // motion as a cantilever bends: its inertia stiffens the bending). Dropped, the motion runs at
-  // a frequency off by about the ratio of that energy to the band's, and its phase drifts. After
-  // each accepted step of length h: the largest |dy/dt|^2_M0 (from y over the step) and the
-  // largest |nu|^2 (the band's kinetic energy, twice); their ratio times the lowest elastic w in
-  // the band times the time run (at least 1) estimates that drift relative to the motion
-  // (quasi_static_inertia); above rtol the run warns (closing_warnings). Measured on a
-  // 10-segment cantilever with a 1 kg tip in 37 Hz and 468 Hz bands chosen for rtol 1e-6, against
-  // bdf at 1e-10 (tests/core/analysis/modal_band_test.cpp): estimates of 0.3 .. 1 times the
-  // errors (1.7e-5 .. 1.7e-3 of the motion) under loads of 0.1 to 10 N ramped, held, dropped,
-  // harmonic and stepped; unchecked, the runs said ok. Keeping those modes' inertia instead (y's
-  // second difference subtracted in the iteration) was tried: lagged, it drove the modes above
-  // the band and the runs diverged or erred more.
+  // motion as a cantilever bends: its inertia stiffens the bending). Dropped, the motion's
+  // frequencies are off by half the ratio of that energy to the band's (Rayleigh's quotient),
+  // and its phase drifts by that times w t. After each accepted step: the largest |dy/dt|^2_M0
+  // (from y at the step's start and at its last stage) and the largest |nu|^2 (twice the band's
+  // kinetic energy); half their ratio times the lowest elastic w in the band times the time run
+  // (at least 1) estimates the drift relative to the motion (quasi_static_inertia); above rtol
+  // the run warns (closing_warnings). Keeping those modes' inertia instead (y's second
+  // difference subtracted in the iteration) was tried: lagged, it drove the modes above the band
+  // and the runs diverged or erred more.
   void check_quasi_static_inertia(double h) {
-    work_n_ = (y_ - y_start_) / h;
+    // y_ is the last stage's, at c h into the step.
+    work_n_ = (y_ - y_start_) / (StepFunctions::c[StepFunctions::kStages - 1] * h);
     quasi_static_kinetic_ = std::max(quasi_static_kinetic_, work_n_.dot(m0_ * work_n_));
     band_kinetic_ = std::max(band_kinetic_, z_.col(1).squaredNorm());
   }
@@ -638,7 +636,7 @@ class ModalExponential : public Integrator {
       if (lambda_(i) > 1e-12 * lambda_.maxCoeff() && (lowest == 0.0 || lambda_(i) < lowest))
         lowest = lambda_(i);
     q.ratio = quasi_static_kinetic_ / band_kinetic_;
-    q.drift = q.ratio * std::max(1.0, std::sqrt(lowest) * (t_ - t0_));
+    q.drift = 0.5 * q.ratio * std::max(1.0, std::sqrt(lowest) * (t_ - t0_));
     return q;
   }
 

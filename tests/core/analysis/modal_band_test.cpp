@@ -282,9 +282,9 @@ double inertia_warning_estimate(const TransientRun& run) {
 }
 
 // Measured against the full modal model at rtol 1e-10 (which bdf at rtol 1e-10 meets to 4e-10 of
-// the motion): at 1 N (slopes of 3e-3) a 37 Hz band left 17 rtol, estimated at 28 rtol, with
-// the modal method and with auto; at 0.1 N 0.18 rtol and no warning. Before the estimate, both
-// runs said ok and nothing else.
+// the motion): at 1 N (slopes of 3e-3) a 37 Hz band left 17 rtol, estimated at 56 rtol, with
+// the modal method and with auto; at 0.1 N 0.18 rtol and no warning (estimated at 0.6 rtol).
+// Before the estimate, both runs said ok and nothing else.
 TEST(ModalBand, ARunWarnsWhenTheModesItKeepsQuasiStaticCarryInertia) {
   const double rtol = 1e-6;
   for (double load : {0.1, 1.0}) {
@@ -311,7 +311,7 @@ TEST(ModalBand, ARunWarnsWhenTheModesItKeepsQuasiStaticCarryInertia) {
       } else {
         EXPECT_GT(error, 5.0 * rtol) << method << ": the band's dropped inertia shows";
         ASSERT_GT(estimate, 0.0) << method << ": no warning";
-        EXPECT_GT(estimate, 0.5 * error) << method;
+        EXPECT_GT(estimate, error) << method;
         EXPECT_LT(estimate, 5.0 * error) << method;
       }
     }

@@ -331,8 +331,8 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionMeasuresRotationsAndJudgesRunsByThem) {
   EXPECT_EQ(chosen["rtol"], 1e-7);
 }
 
-// A single run shares the modal method's dense products among the threads -j gives it (all cores
-// by default), and says in summary.json how many they ran on (product_threads); the run is the
+// A single run shares the modal method's dense products among the threads -j gives it (one
+// without -j), and says in summary.json how many they ran on (product_threads); the run is the
 // same to the bit on one thread. A work-precision study's runs, timed one after another, do the
 // same when -j asks for it. The reference problem in 100 segments (a 600 x 600 basis, above the
 // size from which products use threads).
@@ -357,6 +357,9 @@ TEST_F(SpeedAccuracyRuns, ARunAloneSharesItsProductsAmongTheThreadsAskedFor) {
   const Table b = read_table(dir_ / "two" / "timeseries.csv");
   ASSERT_EQ(a.rows.size(), 5u);
   EXPECT_EQ(a.rows, b.rows);
+  // Without -j, one thread (a run beside other work would wait for the busiest core).
+  ASSERT_NO_FATAL_FAILURE(run_ok(study, "default"));
+  EXPECT_EQ(load_json(dir_ / "default" / "summary.json")["product_threads"], 1);
 
   Json wp = single;
   wp["analyses"][0].erase("integrator");

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/analysis/modal_integrator.hpp"
+#include "tests/support/heavy_tip_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 
 namespace beamrail {
@@ -251,23 +252,17 @@ TEST(ModalBand, EstimateBoundsTheErrorOfRampsTablesAndInitialVelocities) {
     check_band_estimate(label, scene, {1e-3, 1e-5});
 }
 
-// A 1 kg tip on a 10-segment cantilever (1 m, 10 mm square steel) under a tip load in -y ramped
-// smoothly over 0.3 s and held, for 1 s. Bending pulls the tip in (the shortening, second order
-// in the deflection); its axial mode (about 730 Hz) lies above the band chosen for rtol 1e-6,
-// which the transverse load does not ring, so the estimate cannot see it. Quasi-static there,
-// the tip's axial motion loses its inertia, which stiffens the bending: the motion's frequency
-// is off by about the ratio of that motion's kinetic energy to the band's, and the error grows
-// with the deflection squared.
-std::string heavy_tip_cantilever(double load) {
-  return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-    "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-3, 1e-3, 1e-3], "position": [1, 0, 0]}],
-    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq",
-               "segments": 10}],
-    "loads": [{"type": "force", "body": "tip", "value": [0, )" +
-         std::to_string(-load) +
-         R"(, 0], "time": {"type": "smooth_ramp", "from": 0, "to": 0.3}}]})";
+// The heavy-tip cantilever (tests/support/heavy_tip_cantilever.hpp) under a tip load in -y
+// ramped smoothly over 0.3 s and held, for 1 s. Bending pulls the tip in (the shortening, second
+// order in the deflection); its axial mode (about 730 Hz) lies above the band chosen for rtol
+// 1e-6, which the transverse load does not ring, so the estimate cannot see it. Quasi-static
+// there, the tip's axial motion loses its inertia, which stiffens the bending: the motion's
+// frequency is off by about half the ratio of that motion's kinetic energy to the band's, and
+// the error grows with the deflection squared.
+std::string ramped_heavy_tip(double load) {
+  return testing::heavy_tip_cantilever(
+      R"("value": [0, )" + std::to_string(-load) +
+      R"(, 0], "time": {"type": "smooth_ramp", "from": 0, "to": 0.3})");
 }
 
 // Its warning's estimate of the error, or -1 when the run did not warn of it.
@@ -288,7 +283,7 @@ double inertia_warning_estimate(const TransientRun& run) {
 TEST(ModalBand, ARunWarnsWhenTheModesItKeepsQuasiStaticCarryInertia) {
   const double rtol = 1e-6;
   for (double load : {0.1, 1.0}) {
-    const Model model = scene_from_json(heavy_tip_cantilever(load));
+    const Model model = scene_from_json(ramped_heavy_tip(load));
     const int tip = testing::body_index(model, "tip");
     TransientOptions o = options(1.0, 5e-3, 1e-10, 1e-12);
     o.integrator.method = IntegratorMethod::kModal;

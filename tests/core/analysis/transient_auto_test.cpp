@@ -9,6 +9,7 @@
 #include "core/analysis/auto_integrator.hpp"
 #include "core/analysis/modal_integrator.hpp"
 #include "core/scene/scene_loader.hpp"
+#include "tests/support/heavy_tip_cantilever.hpp"
 #include "tests/support/reference_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 #include "tests/support/tumbling_pair.hpp"
@@ -281,14 +282,7 @@ TEST(TransientAuto, BeyondTheModalLimitChoosesABandOrTakesBdf) {
 // diverges, and the modal method stopped at t = 0 ("the forces became non-finite"); auto took
 // 9,057 steps of dirk (1.2 s) instead. Measured against the full modal model at rtol 1e-10.
 TEST(TransientAuto, AFailedModalPhaseGoesOnWithTheImplicitMethod) {
-  const Model model = scene_from_json(R"({
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-    "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-3, 1e-3, 1e-3], "position": [1, 0, 0]}],
-    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq",
-               "segments": 10}],
-    "loads": [{"type": "force", "body": "tip", "value": [0, -10, 0]}]})");
+  const Model model = scene_from_json(testing::heavy_tip_cantilever(R"("value": [0, -10, 0])"));
   const double rtol = 1e-4;
   TransientOptions o = options(0.5, 5e-3, rtol, 1e-3 * rtol);
   o.integrator.method = IntegratorMethod::kModal;

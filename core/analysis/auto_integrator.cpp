@@ -97,6 +97,7 @@ class AutoIntegrator : public Integrator {
     for (const std::string& w : modal->warnings) warnings.push_back(w);
     const bool about_initial = o.about == "initial" || !modal->warnings.empty();
     band_hz = modal->band_hz;
+    limit_inertia(*modal);
     current_ = std::move(modal);
     modal_ = true;
     linear_solver = "modal";
@@ -119,6 +120,10 @@ class AutoIntegrator : public Integrator {
         if (!start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
                             "the modal method failed (" + current_->failure(flag) + ")", &error))
           return fail(error);
+        continue;
+      }
+      if (flag == kModalInertia && modal_) {
+        if (!widen_band(*t, y)) return kAutoFailed;
         continue;
       }
       if (flag != kModalTooFar || !modal_) return flag;
@@ -164,6 +169,7 @@ class AutoIntegrator : public Integrator {
       next->restart(*t, y);
       band_hz = std::max(band_hz, next->band_hz);
       absorb_inertia();
+      limit_inertia(*next);
       current_ = std::move(next);
       record(*t, "modal",
              "body " + who + " turned " + number(turned) +
@@ -205,6 +211,7 @@ class AutoIntegrator : public Integrator {
     m.table.clear();
     m.max_rotation = rotation_limit_;
     m.choose_band = choose_band_;
+    if (widened_) m.max_frequency_hz = widened_hz_;
     m.max_steps = std::max(1L, options_.max_steps - before_.steps);
     return m;
   }
@@ -214,6 +221,58 @@ class AutoIntegrator : public Integrator {
     sum.ratio = std::max(sum.ratio, phase.ratio);
     sum.drift += phase.drift;
     sum.t = phase.t;
+  }
+
+  // A band auto chose (or widened) ends its phase when its dropped inertia passes its share of
+  // what is left of rtol (kAutoInertiaShare).
+  void limit_inertia(Integrator& modal) const {
+    if (!choose_band_ && !widened_) return;
+    set_modal_inertia_limit(modal,
+                            kAutoInertiaShare * std::max(0.0, options_.rtol - inertia_.drift));
+  }
+
+  // The modes a chosen band kept quasi-static carry inertia the run would lose: the run goes on
+  // from (t, y) with every mode, or above kModalIntegratorMaxDofs with a band kAutoBandWidening
+  // times wider, linearized about this state; false (failure_ set) when no modal method starts
+  // and dirk does not either.
+  bool widen_band(double t, N_Vector y) {
+    QuasiStaticInertia q;
+    modal_quasi_static_inertia(*current_, &q);
+    before_ = sum(before_, current_->stats());
+    const bool every = context_->model.n_dofs <= kModalIntegratorMaxDofs;
+    const double hz = every ? 0.0 : kAutoBandWidening * q.band_hz;
+    const std::string why = "the modes above the " + number(q.band_hz) +
+                            " Hz band, kept quasi-static, moved with " + number(q.ratio) +
+                            " of its kinetic energy (inertia the band leaves out: an error "
+                            "estimated at " +
+                            number(q.drift) + " of the motion by t = " + number(t) + " s)";
+    choose_band_ = false;
+    widened_ = true;
+    widened_hz_ = hz;
+    IntegratorOptions m = modal_options();
+    m.about = "initial";
+    m.initial_step = modal_step_size(*current_);
+    std::string error;
+    std::unique_ptr<Integrator> next = make_modal_integrator(m, *context_, y, &error, t);
+    if (!next) {
+      if (!context_->timed_out && !context_->interrupted &&
+          start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, t, y,
+                         why + "; the modal method with more modes could not start: " + error,
+                         &error))
+        return true;
+      fail(error);
+      return false;
+    }
+    next->restart(t, y);
+    band_hz = std::max(band_hz, next->band_hz);
+    absorb_inertia();
+    limit_inertia(*next);
+    current_ = std::move(next);
+    record(t, "modal",
+           why + (every ? ": every mode integrated from here"
+                        : ": a band of " + number(hz) + " Hz from here") +
+               ", linearized about this state");
+    return true;
   }
 
   // Keeps what the current phase dropped before it ends.
@@ -266,6 +325,8 @@ class AutoIntegrator : public Integrator {
   std::unique_ptr<Integrator> current_;
   bool modal_ = false;
   bool choose_band_ = false;  // the modal method's band chosen for rtol
+  bool widened_ = false;      // a chosen band was widened (widen_band): to widened_hz_
+  double widened_hz_ = 0.0;   // [Hz]; 0: every mode
   int short_runs_ = 0;        // consecutive linearizations that lasted few steps
   double rotation_limit_ = kAutoRelinearizeRotation;     // of the current linearization [rad]
   double smallest_limit_ = kAutoMinRelinearizeRotation;  // the limit halves down to this

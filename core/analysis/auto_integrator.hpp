@@ -12,6 +12,13 @@
 //   it saves), the rest of the run is integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps
 //   the fast modes it does not resolve).
 //
+// - A band it chose itself (for rtol) is widened when the inertia of the modes it keeps
+//   quasi-static (their motion at second order: core/analysis/modal_integrator.hpp,
+//   QuasiStaticInertia) is estimated to move the run by kAutoInertiaShare of what rtol leaves:
+//   from that step on, every mode (up to kModalIntegratorMaxDofs) or a band kAutoBandWidening
+//   times wider, linearized about that state. A band given in max_frequency_hz is the user's
+//   model: it is kept, and the run warns instead.
+//
 // Every change is a MethodPhase of the result with its reason.
 #pragma once
 
@@ -51,6 +58,13 @@ inline constexpr double kAutoMaxDampingRatio = 0.1;
 // at rtol, the others quasi-static (per step ~ bodies x modes instead of bodies^2). At 600 (a
 // 100-segment cantilever, rtol 1e-6) the chosen band (77 modes) ran in 1.2 s, every mode in 1.8 s.
 inline constexpr int kAutoChosenBandDofs = 600;
+
+// A chosen band's phase ends when its quasi-static inertia's drift passes this share of what is
+// left of rtol (rtol less the drift of the phases before): the drift already run stays in the
+// result, so the run's sum stays below rtol.
+inline constexpr double kAutoInertiaShare = 0.5;
+// Above kModalIntegratorMaxDofs, the band's top frequency is multiplied by this.
+inline constexpr double kAutoBandWidening = 4.0;
 
 // The auto integrator for the system in `context`, starting at (0, y0).
 std::unique_ptr<Integrator> make_auto_integrator(const IntegratorOptions& options,

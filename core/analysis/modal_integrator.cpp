@@ -43,12 +43,16 @@ void subtract_product(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, Eigen:
   out -= work;
 }
 
+// set_inertia_limit applies from this angle of the band's slowest elastic mode on [rad].
+constexpr double kInertiaSettling = 2.0;
+
 enum Flag {
   kOk = 0,
   kTooManySteps = -1,
   kStepTooSmall = kModalStepTooSmall,
   kNonFinite = kModalNonFinite,
-  kTooFar = kModalTooFar
+  kTooFar = kModalTooFar,
+  kInertia = kModalInertia
 };
 
 class ModalExponential : public Integrator {
@@ -116,12 +120,22 @@ class ModalExponential : public Integrator {
   int advance(double tout, double tstop, N_Vector y, double* t) override {
     const double target = std::min(tout, tstop);
     int flag = kOk;
-    while (t_ < target && flag == kOk) flag = step_towards(target);
-    // The quasi-static part of the state reported (kept for the next step).
-    if (flag == kOk && reduced_ && !have_n0_) {
+    while (t_ < target && flag == kOk) {
+      flag = step_towards(target);
+      if (flag == kOk && inertia_limit_ > 0.0 && inertia_settled() &&
+          quasi_static_inertia().drift > inertia_limit_)
+        flag = kInertia;
+    }
+    // The quasi-static part of the state reported (kept for the next step), and its rate.
+    if ((flag == kOk || flag == kInertia) && reduced_ && !have_n0_) {
       try {
+        const int reached = flag;
         if (!nonlinear(t_, z_, x_, n0_, &flag)) flag = fail_flag(flag);
         have_n0_ = flag == kOk;
+        if (have_n0_) {
+          flag = reached;
+          quasi_static_rate();
+        }
       } catch (const std::exception& e) {
         context_->callback_error = e.what();
         flag = kNonFinite;
@@ -135,6 +149,8 @@ class ModalExponential : public Integrator {
   void restart(double t, N_Vector y) override {
     t_ = t;
     have_n0_ = false;
+    rate_known_ = false;
+    last_step_ = 0.0;
     from_states(N_VGetArrayPointer(y));
   }
 
@@ -186,6 +202,8 @@ class ModalExponential : public Integrator {
         return "the forces became non-finite (the motion diverged)";
       case kTooFar:
         return detail_;
+      case kInertia:
+        return quasi_static_inertia_warning(quasi_static_inertia());
       default:
         return "modal integrator flag " + std::to_string(flag);
     }
@@ -248,6 +266,10 @@ class ModalExponential : public Integrator {
       lambda_(i) = phi_.col(i).dot(k0 * phi_.col(i)) / phi_.col(i).dot(m0_ * phi_.col(i));
     reduced_ = m_ < n_;
     if (!reduced_) return true;
+    for (Eigen::Index i = 0; i < m_; ++i)
+      if (lambda_(i) > 1e-12 * lambda_.maxCoeff() &&
+          (lowest_elastic_ < 0.0 || lambda_(i) < lowest_elastic_))
+        lowest_elastic_ = lambda_(i);
     // Shifted by a hundredth of the band's w^2 so that rigid-body and mechanism modes (in the
     // band) leave it regular: the iteration's fixed point (no acceleration outside the band) is
     // the same; its contraction is at most shift_ / w^2 of the band.
@@ -373,8 +395,30 @@ class ModalExponential : public Integrator {
     return within;
   }
 
-  // The accepted state (a rotation past the limit is reported by the next step that uses it).
-  void to_states(double* y) { states_of(x_, y, false); }
+  // The accepted state (a rotation past the limit is reported by the next step that uses it),
+  // with the quasi-static part's rate in the velocities when known.
+  void to_states(double* y) {
+    if (!(reduced_ && rate_known_)) {
+      states_of(x_, y, false);
+      return;
+    }
+    Block x = x_;
+    x.col(1) += y_rate_;
+    states_of(x, y, false);
+  }
+
+  // dy/dt at the accepted state, from y at the last step's start, at its last stage (c h in) and
+  // at its end (y_, converged): the derivative of the parabola through them, second order in h.
+  // The band's velocities leave it out (y is not a state of the method), so that a run handed on
+  // to another method (auto: every mode) would otherwise start with the quasi-static part at
+  // rest and ring the modes above the band.
+  void quasi_static_rate() {
+    if (!(last_step_ > 0.0)) return;
+    const double c = StepFunctions::c[StepFunctions::kStages - 1], h = last_step_;
+    y_rate_ = ((1.0 - c) / (c * h)) * y_begin_ - (1.0 / (c * (1.0 - c) * h)) * y_stage_ +
+              ((2.0 - c) / ((1.0 - c) * h)) * y_;
+    rate_known_ = true;
+  }
 
   // The accelerations (dv/dt, d^2 theta/dt^2) into acceleration_ at the physical state x whose
   // 13 states states_of has just written into y13_; false when they are not finite.
@@ -621,6 +665,10 @@ class ModalExponential : public Integrator {
   void check_quasi_static_inertia(double h) {
     // y_ is the last stage's, at c h into the step.
     work_n_ = (y_ - y_start_) / (StepFunctions::c[StepFunctions::kStages - 1] * h);
+    y_begin_ = y_start_;
+    y_stage_ = y_;
+    last_step_ = h;
+    rate_known_ = false;
     quasi_static_kinetic_ = std::max(quasi_static_kinetic_, work_n_.dot(m0_ * work_n_));
     band_kinetic_ = std::max(band_kinetic_, z_.col(1).squaredNorm());
   }
@@ -631,13 +679,22 @@ class ModalExponential : public Integrator {
     q.band_hz = band_hz_;
     q.t = t_;
     if (!(band_kinetic_ > 0.0)) return q;
-    double lowest = 0.0;
-    for (Eigen::Index i = 0; i < lambda_.size(); ++i)
-      if (lambda_(i) > 1e-12 * lambda_.maxCoeff() && (lowest == 0.0 || lambda_(i) < lowest))
-        lowest = lambda_(i);
     q.ratio = quasi_static_kinetic_ / band_kinetic_;
-    q.drift = 0.5 * q.ratio * std::max(1.0, std::sqrt(lowest) * (t_ - t0_));
+    q.drift =
+        0.5 * q.ratio * std::max(1.0, std::sqrt(std::max(0.0, lowest_elastic_)) * (t_ - t0_));
     return q;
+  }
+
+  // advance() stops (kInertia) after the step whose drift first passes `drift` (0: never), once
+  // inertia_settled().
+  void set_inertia_limit(double drift) { inertia_limit_ = drift; }
+
+  // Whether the band's slowest elastic mode has turned kInertiaSettling rad since the run began.
+  // Before, a load that starts from rest gives a ratio of kinetic energies far above the
+  // motion's: the quasi-static part follows the load at once, the band only over about a third
+  // of its period (the heavy tip's smooth ramp: 9e-5 at 5 ms, 1e-7 at 2 rad, 5e-8 from then on).
+  bool inertia_settled() const {
+    return !(lowest_elastic_ > 0.0) || std::sqrt(lowest_elastic_) * (t_ - t0_) >= kInertiaSettling;
   }
 
   bool band_limited() const { return reduced_; }
@@ -696,9 +753,15 @@ class ModalExponential : public Integrator {
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
   Block stage_z_, next_, difference_;  // work space: a stage's modal state, a trial step, errors
   Eigen::VectorXd y_start_;            // work space: the quasi-static part at the accepted state
+  // The last accepted step's y at its start and at its last stage, and its size (0: none since
+  // the start or a restart); the rate of y at the accepted state when rate_known_.
+  Eigen::VectorXd y_begin_, y_stage_, y_rate_;
+  double last_step_ = 0.0;
+  bool rate_known_ = false;
   double quasi_static_kinetic_ = 0.0;  // check_quasi_static_inertia: the largest |dy/dt|^2_M0
   double band_kinetic_ = 0.0;          // and |nu|^2 so far
-  double lowest_elastic_ = -1.0;       // the lowest elastic w^2 in the band (-1: not yet found)
+  double lowest_elastic_ = -1.0;       // the lowest elastic w^2 in the band (-1: none)
+  double inertia_limit_ = 0.0;         // set_inertia_limit
   std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote
   Eigen::VectorXd acceleration_;   // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;
@@ -752,6 +815,13 @@ std::string quasi_static_inertia_warning(const QuasiStaticInertia& q) {
                 "integrate more modes (a higher max_frequency_hz) or every mode",
                 q.band_hz, q.ratio, q.drift, q.t);
   return text;
+}
+
+bool set_modal_inertia_limit(Integrator& integrator, double drift) {
+  auto* modal = dynamic_cast<ModalExponential*>(&integrator);
+  if (!modal || !modal->band_limited()) return false;
+  modal->set_inertia_limit(drift);
+  return true;
 }
 
 double modal_step_size(const Integrator& integrator) {

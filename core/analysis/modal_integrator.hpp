@@ -67,6 +67,9 @@ inline constexpr int kModalTooFar = -20;
 // state).
 inline constexpr int kModalStepTooSmall = -3;
 inline constexpr int kModalNonFinite = -8;
+// The flag of a band-limited run stopped because the inertia its quasi-static modes leave out
+// passed the limit of set_modal_inertia_limit (y and t: the step's accepted state where it did).
+inline constexpr int kModalInertia = -21;
 
 // The eigenvalues w^2 of a modal integrator's linearization: the smallest positive one and the
 // largest [1/s^2]. False when `integrator` is not a modal integrator.
@@ -88,6 +91,10 @@ struct QuasiStaticInertia {
 bool modal_quasi_static_inertia(const Integrator& integrator, QuasiStaticInertia* out);
 // The run's warning for a drift above rtol.
 std::string quasi_static_inertia_warning(const QuasiStaticInertia& inertia);
+// Makes a band-limited modal integrator stop (kModalInertia) after the step at which its
+// QuasiStaticInertia drift first passes `drift` (0: never, the default), so that its caller can
+// go on with more modes; false when `integrator` is not a band-limited modal integrator.
+bool set_modal_inertia_limit(Integrator& integrator, double drift);
 
 // The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
 double modal_step_size(const Integrator& integrator);

@@ -269,8 +269,9 @@ class AutoIntegrator : public Integrator {
     limit_inertia(*next);
     current_ = std::move(next);
     record(t, "modal",
-           why + (every ? ": every mode integrated from here"
-                        : ": a band of " + number(hz) + " Hz from here") +
+           why +
+               (every ? ": every mode integrated from here"
+                      : ": a band of " + number(hz) + " Hz from here") +
                ", linearized about this state");
     return true;
   }

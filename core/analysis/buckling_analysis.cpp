@@ -337,11 +337,23 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
                  nonlinearity));
     }
     result.ok = true;
-    if (result.positive_factors < wanted)
+    if (result.positive_factors < wanted) {
+      // An unsplit beam has no stress stiffness of its own, so it buckles in no mode.
+      std::string unsplit;
+      for (const Beam& e : reference.beams)
+        if (e.segment == 0) {
+          unsplit = "; beam \"" + e.name +
+                    "\" is one element, which has no stress stiffness of its own and buckles "
+                    "only as part of a chain (docs/model.md \"Axial force and bending\"): give "
+                    "compressed beams \"segments\"";
+          break;
+        }
       result.warnings.push_back(
           "the scaled loads buckle the structure in " + std::to_string(result.positive_factors) +
           " mode(s) only (" + std::to_string(wanted) +
-          " asked for): they compress too little of it; the missing factors are infinite");
+          " asked for): they compress too little of it; the missing factors are infinite" +
+          unsplit);
+    }
   } catch (const DeadlinePassed&) {
     result.ok = false;
     result.timed_out = true;

@@ -16,6 +16,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/analysis/axial_force_check.hpp"
 #include "core/analysis/deadline.hpp"
 #include "core/analysis/element_deformation.hpp"
 #include "core/analysis/sparse_structure.hpp"
@@ -617,6 +618,19 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
       result.message =
           "the configuration is not a stable equilibrium: " + std::to_string(unstable) +
           " mode(s) with negative stiffness (buckling, or an unstable equilibrium)";
+    }
+    // What the beam law leaves out of the elements' own axial forces, per mode
+    // (core/analysis/axial_force_check.hpp).
+    if (result.ok) {
+      const MissingAxialForces missing(model, data);
+      std::vector<Eigen::VectorXd> shapes;
+      std::vector<double> eigenvalues;
+      for (const Mode& mode : result.modes) {
+        shapes.push_back(mode.kind == Mode::Kind::kElastic ? mode.shape : Eigen::VectorXd());
+        eigenvalues.push_back(mode.kind == Mode::Kind::kElastic ? mode.eigenvalue : 0.0);
+      }
+      if (std::string w = modal_axial_force_warning(missing, shapes, eigenvalues); !w.empty())
+        result.warnings.push_back(std::move(w));
     }
     if (result.ok && nonsymmetric && !loaded_nonconservatively(model, options))
       result.warnings.push_back(

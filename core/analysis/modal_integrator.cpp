@@ -680,8 +680,7 @@ class ModalExponential : public Integrator {
     q.t = t_;
     if (!(band_kinetic_ > 0.0)) return q;
     q.ratio = quasi_static_kinetic_ / band_kinetic_;
-    q.drift =
-        0.5 * q.ratio * std::max(1.0, std::sqrt(std::max(0.0, lowest_elastic_)) * (t_ - t0_));
+    q.drift = 0.5 * q.ratio * std::max(1.0, std::sqrt(std::max(0.0, lowest_elastic_)) * (t_ - t0_));
     return q;
   }
 

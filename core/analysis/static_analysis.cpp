@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/analysis/axial_force_check.hpp"
 #include "core/analysis/deadline.hpp"
 #include "core/analysis/deformation_check.hpp"
 #include "core/analysis/modal_analysis.hpp"
@@ -241,6 +242,22 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
               : "the tangent stiffness has " + std::to_string(newton.singular) +
                     " direction(s) without stiffness (a free mechanism); the equilibrium closest "
                     "to the initial configuration along them is reported");
+    // What the beam law leaves out of the elements' own axial forces, measured on this
+    // equilibrium (core/analysis/axial_force_check.hpp).
+    if (result.ok && newton.singular == 0) {
+      const MissingAxialForces missing(model, data);
+      std::string why;
+      if (missing.any()) {
+        compute_tangent(model, data, options.time, false, 1.0);
+        if (newton.solver.factorize(model, data, &why) && newton.solver.null_directions == 0) {
+          const AxialForceEffect effect = static_axial_force_effect(
+              model, data, missing,
+              [&](const Eigen::VectorXd& b) { return newton.solver.solve(b); });
+          if (std::string w = static_axial_force_warning(missing, effect); !w.empty())
+            result.warnings.push_back(std::move(w));
+        }
+      }
+    }
   } catch (const std::exception& e) {
     result.ok = false;
     result.message = e.what();

@@ -48,7 +48,7 @@ int response_index(const Study& study, const std::string& name) {
 
 }  // namespace
 
-void resolve_expressions(Study& study, Diagnostics& diag) {
+void resolve_expressions(Study& study, Diagnostics& diag, const std::set<std::string>& declared) {
   std::vector<int> expressions;
   for (size_t k = 0; k < study.responses.size(); ++k) {
     ResponseSpec& r = study.responses[k];
@@ -68,6 +68,8 @@ void resolve_expressions(Study& study, Diagnostics& diag) {
       if (i == static_cast<int>(k)) {
         diag.error(at.file, at.pointer, "the expression reads its own response \"" + name + "\"");
         ok = false;
+      } else if (i < 0 && declared.count(name)) {
+        ok = false;  // that response's own errors are reported
       } else if (i < 0) {
         std::string known;
         for (const ResponseSpec& s : study.responses)

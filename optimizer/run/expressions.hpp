@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -16,7 +17,10 @@ struct Study;
 
 // Checks every expression response: its syntax, that it names only other responses, and that no
 // expression reads itself through others. Sets each one's inputs and study.expression_order.
-void resolve_expressions(Study& study, Diagnostics& diag);
+// `declared`: every response name the study file gives, read or not; an expression that names
+// one whose own errors kept it out of study.responses is left out without another error.
+void resolve_expressions(Study& study, Diagnostics& diag,
+                         const std::set<std::string>& declared = {});
 
 // Computes the expression responses from the others in `values` (one per study.responses, in
 // place). An input that is NaN (not computed) gives NaN. Returns a warning for each expression

@@ -166,19 +166,22 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
       check_load_cases(study, diag);
     }
 
+    std::set<std::string> declared;  // every response name given, read or not
     if (const Json* responses = r.member("responses", false)) {
       if (!responses->is_object()) {
         r.error("responses", "expected an object of named responses");
       } else {
         // Checked even when the scene has errors (body names then go unchecked).
         const Model* m = model ? &study.model : nullptr;
-        for (const auto& item : responses->items())
+        for (const auto& item : responses->items()) {
+          declared.insert(item.key());
           if (auto s = read_response(item.key(), item.value(), root / "responses" / item.key(),
                                      study, m, diag))
             study.responses.push_back(*s);
+        }
       }
     }
-    resolve_expressions(study, diag);
+    resolve_expressions(study, diag, declared);
     if (const Json* design = r.member("study", false))
       study.design = read_design_study(*design, root / "study", study, diag);
     // What a run writes besides the tables (docs/study_files.md "Outputs").

@@ -165,5 +165,23 @@ TEST(Responses, BadExpressionsMassesAndLinksAreRefusedWithTheirPointers) {
   expect_refused(doc, "/study/variables/0/offsets", "");
 }
 
+// An expression that reads a response whose own errors kept it out is not reported again as
+// reading "no response of the study" (it was, beside a scene error that dropped the response).
+TEST(Responses, AnExpressionOfARefusedResponseAddsNoSecondError) {
+  Json doc = base();
+  doc["responses"]["dy"]["body"] = "nobody";
+  doc["responses"]["e"] = {{"quantity", "expression"}, {"expression", "2 * dy"}};
+  Diagnostics diag;
+  EXPECT_FALSE(load(doc, diag));
+  int errors = 0;
+  for (const Diagnostic& d : diag.items()) {
+    ++errors;
+    EXPECT_EQ(d.message.find("is no response of the study"), std::string::npos) << diag.format();
+  }
+  EXPECT_EQ(errors, 1) << diag.format();
+  doc["responses"]["e"]["expression"] = "2 * dx";  // a name no response has: still an error
+  expect_refused(doc, "/responses/e/expression", "\"dx\" is no response of the study");
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -1,5 +1,6 @@
 #include "core/analysis/axial_force_check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -10,8 +11,9 @@ namespace beamrail {
 namespace {
 
 constexpr int kD = kDofsPerBody;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// How much more a beam of n elements would need: the effect falls as 1/n^2.
+// How many elements would bring `relative` to 1 %: the effect falls as 1/n^2.
 int segments_for(int elements, double relative) {
   if (!std::isfinite(relative)) return 0;
   return static_cast<int>(std::ceil(elements * std::sqrt(relative / kAxialForceWarning)));
@@ -20,24 +22,51 @@ int segments_for(int elements, double relative) {
 std::string advice(const MissingAxialForces& missing, int beam, double relative) {
   const int n = missing.beam_elements()[beam];
   const double force = missing.beam_forces()[beam];
-  char text[400];
   const int needed = segments_for(n, relative);
-  std::snprintf(text, sizeof text,
-                "mostly beam \"%s\" (%s, %d element%s): the beam law leaves out what an "
-                "element's own axial force does to its bending (no P-delta within an element: "
-                "docs/model.md \"Axial force and bending\")%s",
-                missing.beam_names()[beam].c_str(), force < 0.0 ? "compressed" : "stretched", n,
-                n == 1 ? "" : "s",
-                needed > n ? (std::string("; more segments reduce it as 1/n^2 (\"segments\": ") +
-                              std::to_string(needed) + " for 1 %)")
-                                 .c_str()
-                           : "");
-  return text;
+  const std::string more =
+      needed > n ? "; more segments reduce it as 1/n^2 (\"segments\": " + std::to_string(needed) +
+                       " for 1 %)"
+                 : "";
+  return "mostly beam \"" + missing.beam_names()[beam] + "\" (" +
+         (force < 0.0 ? "compressed, " : "stretched, ") + std::to_string(n) +
+         (n == 1 ? " element" : " elements") +
+         "): the beam law leaves out what an element's own axial force does to its bending (no "
+         "P-delta within an element: docs/model.md \"Axial force and bending\")" +
+         more;
+}
+
+// The largest of per-scene-beam values by magnitude; -1 when all are 0.
+int largest(const std::vector<double>& values) {
+  int which = -1;
+  double most = 0.0;
+  for (size_t g = 0; g < values.size(); ++g)
+    if (std::abs(values[g]) > most) {
+      most = std::abs(values[g]);
+      which = static_cast<int>(g);
+    }
+  return which;
+}
+
+double sum(const std::vector<double>& values) {
+  double s = 0.0;
+  for (double v : values) s += v;
+  return s;
 }
 
 }  // namespace
 
 MissingAxialForces::MissingAxialForces(const Model& model, const Data& data) : n_(model.n_dofs) {
+  build(model, data, nullptr);
+}
+
+MissingAxialForces::MissingAxialForces(const Model& model, const Data& data,
+                                       const Eigen::VectorXd& direction)
+    : n_(model.n_dofs) {
+  build(model, data, &direction);
+}
+
+void MissingAxialForces::build(const Model& model, const Data& data,
+                               const Eigen::VectorXd* direction) {
   for (const Beam& b : model.beams) {
     const std::string& group = b.group.empty() ? b.name : b.group;
     int g = 0;
@@ -52,61 +81,103 @@ MissingAxialForces::MissingAxialForces(const Model& model, const Data& data) : n
     if (!(l > 0.0)) continue;
     const ElementFrames<double> f = element_frames(b.ends, data.pose[b.ends.body1],
                                                    data.pose[b.ends.body2], rotation_measure(b));
-    const double force = b.ea * (f.xi(0) - l) / l;
-    if (!(force != 0.0) || !std::isfinite(force)) continue;
-    if (std::abs(force) > std::abs(forces_[g])) forces_[g] = force;
     Element e;
     e.free1 = model.bodies[b.ends.body1].free_index;
     e.free2 = model.bodies[b.ends.body2].free_index;
     if (e.free1 < 0 && e.free2 < 0) continue;
     e.beam = g;
     e.e1 = f.E1;
+    e.t = f.t;
     e.r2 = f.R2;
     e.lever1 = f.lever1;
     e.offset = f.xi;
-    e.k = kStringStiffnessFactor * force / l;
+    e.turn = f.phi;
+    e.l = l;
+    if (direction) {
+      Vec3 dxi, dphi;
+      change(e, *direction, &dxi, &dphi);
+      e.n = b.ea * dxi(0) / l;
+    } else {
+      e.n = b.ea * (f.xi(0) - l) / l;
+    }
+    if (!(e.n != 0.0) || !std::isfinite(e.n)) continue;
+    if (std::abs(e.n) > std::abs(forces_[g])) forces_[g] = e.n;
     elements_.push_back(e);
   }
 }
 
-Vec3 MissingAxialForces::offset_change(const Element& e, const Eigen::VectorXd& v) const {
-  // d xi = E1^T (dc2 - dc1 - R2 x dtheta2 + (p2 - c1) x dtheta1) (docs/model.md "Beams").
-  Vec3 d = Vec3::Zero();
+bool MissingAxialForces::compressed() const {
+  for (const Element& e : elements_)
+    if (e.n < 0.0) return true;
+  return false;
+}
+
+void MissingAxialForces::change(const Element& e, const Eigen::VectorXd& v, Vec3* dxi,
+                                Vec3* dphi) const {
+  // d xi = E1^T (dc2 - dc1 - R2 x dtheta2 + (p2 - c1) x dtheta1), d phi = T E1^T (dtheta2 -
+  // dtheta1) (docs/model.md "Beams").
+  Vec3 d = Vec3::Zero(), turn = Vec3::Zero();
   if (e.free2 >= 0) {
     const Vec3 dc = v.segment<3>(kD * e.free2), dt = v.segment<3>(kD * e.free2 + 3);
     d += dc - e.r2.cross(dt);
+    turn += dt;
   }
   if (e.free1 >= 0) {
     const Vec3 dc = v.segment<3>(kD * e.free1), dt = v.segment<3>(kD * e.free1 + 3);
     d += -dc + e.lever1.cross(dt);
+    turn -= dt;
   }
-  return e.e1.transpose() * d;
+  *dxi = e.e1.transpose() * d;
+  *dphi = e.t * (e.e1.transpose() * turn);
 }
 
-void MissingAxialForces::add(const Element& e, const Vec3& f, Eigen::VectorXd& out) const {
-  // The virtual work f . d(p2 - p1) with d(p2 - p1) = E1 d xi: the transpose of offset_change.
+void MissingAxialForces::local_forces(const Element& e, const Vec3& xi, const Vec3& phi, Vec3* f,
+                                      Vec3* m) {
+  // Per plane, -N / (30 l) [36, -3 l; -3 l, 4 l^2] (v, t): x-y with (xi_y, phi_z), x-z with
+  // (xi_z, -phi_y).
+  const double c = e.n / (30.0 * e.l), l = e.l;
+  const auto plane = [&](double v, double t, double* force, double* moment) {
+    *force = -c * (36.0 * v - 3.0 * l * t);
+    *moment = -c * (-3.0 * l * v + 4.0 * l * l * t);
+  };
+  double fy, mz, fz, my;
+  plane(xi(1), phi(2), &fy, &mz);
+  plane(xi(2), -phi(1), &fz, &my);
+  *f = Vec3(0.0, fy, fz);
+  *m = Vec3(0.0, -my, mz);
+}
+
+void MissingAxialForces::add(const Element& e, const Vec3& f, const Vec3& m,
+                             Eigen::VectorXd& out) const {
+  // The virtual work f . d xi + m . d phi: the transpose of change().
+  const Vec3 force = e.e1 * f, moment = e.e1 * (e.t.transpose() * m);
   if (e.free2 >= 0) {
-    out.segment<3>(kD * e.free2) += f;
-    out.segment<3>(kD * e.free2 + 3) += e.r2.cross(f);
+    out.segment<3>(kD * e.free2) += force;
+    out.segment<3>(kD * e.free2 + 3) += e.r2.cross(force) + moment;
   }
   if (e.free1 >= 0) {
-    out.segment<3>(kD * e.free1) -= f;
-    out.segment<3>(kD * e.free1 + 3) -= e.lever1.cross(f);
+    out.segment<3>(kD * e.free1) -= force;
+    out.segment<3>(kD * e.free1 + 3) -= e.lever1.cross(force) + moment;
   }
 }
 
 Eigen::VectorXd MissingAxialForces::at_state() const {
   Eigen::VectorXd out = Eigen::VectorXd::Zero(n_);
-  for (const Element& e : elements_)
-    add(e, e.e1 * Vec3(0.0, -e.k * e.offset(1), -e.k * e.offset(2)), out);
+  for (const Element& e : elements_) {
+    Vec3 f, m;
+    local_forces(e, e.offset, e.turn, &f, &m);
+    add(e, f, m, out);
+  }
   return out;
 }
 
 Eigen::VectorXd MissingAxialForces::of(const Eigen::VectorXd& v) const {
   Eigen::VectorXd out = Eigen::VectorXd::Zero(n_);
   for (const Element& e : elements_) {
-    const Vec3 d = offset_change(e, v);
-    add(e, e.e1 * Vec3(0.0, -e.k * d(1), -e.k * d(2)), out);
+    Vec3 dxi, dphi, f, m;
+    change(e, v, &dxi, &dphi);
+    local_forces(e, dxi, dphi, &f, &m);
+    add(e, f, m, out);
   }
   return out;
 }
@@ -114,8 +185,10 @@ Eigen::VectorXd MissingAxialForces::of(const Eigen::VectorXd& v) const {
 std::vector<double> MissingAxialForces::stiffness_energy(const Eigen::VectorXd& v) const {
   std::vector<double> out(names_.size(), 0.0);
   for (const Element& e : elements_) {
-    const Vec3 d = offset_change(e, v);
-    out[e.beam] += e.k * (d(1) * d(1) + d(2) * d(2));
+    Vec3 dxi, dphi, f, m;
+    change(e, v, &dxi, &dphi);
+    local_forces(e, dxi, dphi, &f, &m);
+    out[e.beam] -= f.dot(dxi) + m.dot(dphi);
   }
   return out;
 }
@@ -125,51 +198,75 @@ AxialForceEffect static_axial_force_effect(
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve) {
   AxialForceEffect effect;
   if (!missing.any()) return effect;
+  const Eigen::Index n = model.n_dofs;
+  // Stability with the missing stiffness: the lowest eigenvalue of A = S^-1 G (real: K^-1 K_s
+  // with K positive definite) by power iterations, shifted by the dominant one when that is
+  // positive; at or below -1, K + K_s is not positive definite.
+  if (missing.compressed()) {
+    const auto dominant = [&](double shift, int iterations) {
+      Eigen::VectorXd x(n);
+      for (Eigen::Index i = 0; i < n; ++i) x(i) = std::sin(1.0 + 0.7 * static_cast<double>(i));
+      x.normalize();
+      double value = 0.0;
+      for (int it = 0; it < iterations; ++it) {
+        Eigen::VectorXd y = solve(missing.of(x)) - shift * x;
+        if (!y.allFinite()) return 0.0;
+        value = x.dot(y);
+        const double size = y.norm();
+        if (!(size > 0.0)) return 0.0;
+        x = y / size;
+      }
+      return value + shift;
+    };
+    double lowest = dominant(0.0, 40);
+    if (lowest > 0.0) lowest = dominant(lowest, 60);
+    effect.unstable = lowest <= -1.0;
+  }
+  const Eigen::VectorXd g0 = missing.at_state();
   double moved = 0.0;
   for (int b : model.free_bodies) moved = std::max(moved, data.pose[b].u.norm());
-  if (!(moved > 0.0)) return effect;
-  const Eigen::VectorXd g0 = missing.at_state();
-  const auto largest = [&](const Eigen::VectorXd& v) {
-    double m = 0.0;
-    for (Eigen::Index k = 0; k < v.size() / kD; ++k) m = std::max(m, v.segment<3>(kD * k).norm());
-    return m;
-  };
-  Eigen::VectorXd e = -solve(g0);
-  if (!e.allFinite()) return effect;
-  // e = -S^-1 (g0 + G e): the missing forces of the corrected state; a contraction unless the
-  // left-out compression softens the structure past its stiffness.
-  double size = largest(e);
-  for (int it = 0; it < 100; ++it) {
-    const Eigen::VectorXd next = -solve(g0 + missing.of(e));
-    if (!next.allFinite()) break;
-    const double change = largest(next - e);
-    e = next;
-    const double previous = size;
-    size = largest(e);
-    if (change <= 1e-3 * size) break;
-    if (it > 10 && size > 1.5 * previous) {  // growing: diverges
-      size = std::numeric_limits<double>::infinity();
-      break;
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+  if (moved > 0.0 && g0.squaredNorm() > 0.0) {
+    // e = -S^-1 (g0 + G e): the missing forces of the corrected state.
+    e = -solve(g0);
+    double change = kInf;
+    for (int it = 0; it < 100 && e.allFinite(); ++it) {
+      const Eigen::VectorXd next = -solve(g0 + missing.of(e));
+      change = (next - e).norm();
+      e = next;
+      if (change <= 1e-3 * e.norm()) break;
     }
-    if (it == 99) size = std::numeric_limits<double>::infinity();
+    if (!e.allFinite() || !(change <= 1e-2 * e.norm())) {
+      effect.relative = kInf;
+      e = -solve(g0);
+    } else {
+      const double floor = kAxialForceFloor * moved;
+      for (int b : model.free_bodies) {
+        const int k = model.bodies[b].free_index;
+        const Vec3 c = e.segment<3>(kD * k);
+        if (!(c.norm() > 0.0)) continue;
+        const double along = std::abs(data.pose[b].u.dot(c.normalized()));
+        effect.relative = std::max(effect.relative, c.norm() / std::max(along, floor));
+      }
+    }
   }
-  effect.relative = size / moved;
-  // The beam whose missing stiffness the correction works against most.
-  const std::vector<double> energy = missing.stiffness_energy(e.allFinite() ? e : -solve(g0));
-  double most = -1.0;
-  for (size_t g = 0; g < energy.size(); ++g)
-    if (std::abs(energy[g]) > most) {
-      most = std::abs(energy[g]);
-      effect.beam = static_cast<int>(g);
-    }
+  if (!e.allFinite()) e = Eigen::VectorXd::Zero(n);
+  effect.beam = largest(missing.stiffness_energy(e));
+  if (effect.beam < 0) effect.beam = largest(missing.beam_forces());
   return effect;
 }
 
 std::string static_axial_force_warning(const MissingAxialForces& missing,
                                        const AxialForceEffect& effect) {
-  if (!(effect.relative > kAxialForceWarning) || effect.beam < 0) return "";
+  if (effect.beam < 0) return "";
   char text[300];
-  if (std::isfinite(effect.relative))
+  if (effect.unstable)
+    std::snprintf(text, sizeof text,
+                  "the axial forces of the beams would make this equilibrium unstable (buckled) "
+                  "beyond what the model holds, ");
+  else if (!(effect.relative > kAxialForceWarning))
+    return "";
+  else if (std::isfinite(effect.relative))
     std::snprintf(text, sizeof text,
                   "the axial forces of the beams change the displacements by about %.3g of "
                   "them beyond what the model holds, ",
@@ -177,8 +274,45 @@ std::string static_axial_force_warning(const MissingAxialForces& missing,
   else
     std::snprintf(text, sizeof text,
                   "the axial forces of the beams change the displacements by more than they "
-                  "are (with them the structure would buckle), beyond what the model holds, ");
-  return text + advice(missing, effect.beam, effect.relative);
+                  "are beyond what the model holds, ");
+  return text + advice(missing, effect.beam, effect.unstable ? kInf : effect.relative);
+}
+
+std::string buckling_axial_force_warning(const MissingAxialForces& reference,
+                                         const MissingAxialForces& per_factor,
+                                         const std::vector<Eigen::VectorXd>& shapes,
+                                         const std::vector<double>& factors,
+                                         const std::vector<double>& stiffness) {
+  if (!reference.any() && !per_factor.any()) return "";
+  double worst = 0.0;
+  int mode = -1, beam = -1;
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    if (!(factors[i] > 0.0) || !(stiffness[i] > 0.0)) continue;
+    const std::vector<double> e1 = per_factor.stiffness_energy(shapes[i]);
+    const double numerator = stiffness[i] + sum(reference.stiffness_energy(shapes[i]));
+    const double denominator = stiffness[i] / factors[i] - sum(e1);
+    const double size = denominator > 0.0 && numerator > 0.0
+                            ? std::abs(numerator / denominator / factors[i] - 1.0)
+                            : kInf;
+    if (size > worst) {
+      worst = size;
+      mode = static_cast<int>(i);
+      beam = largest(e1);
+    }
+  }
+  if (!(worst > kAxialForceWarning) || beam < 0) return "";
+  char text[300];
+  if (std::isfinite(worst))
+    std::snprintf(text, sizeof text,
+                  "the axial forces of the beams change buckling factor %d by about %.3g of it "
+                  "beyond what the model holds, ",
+                  mode + 1, worst);
+  else
+    std::snprintf(text, sizeof text,
+                  "the axial forces of the beams leave buckling factor %d without meaning (the "
+                  "stiffness they leave out outweighs the shape's) beyond what the model holds, ",
+                  mode + 1);
+  return text + advice(per_factor, beam, worst);
 }
 
 std::string modal_axial_force_warning(const MissingAxialForces& missing,
@@ -190,23 +324,13 @@ std::string modal_axial_force_warning(const MissingAxialForces& missing,
   for (size_t i = 0; i < shapes.size(); ++i) {
     if (!(eigenvalues[i] > 0.0)) continue;
     const std::vector<double> energy = missing.stiffness_energy(shapes[i]);
-    double sum = 0.0, most = -1.0;
-    int which = -1;
-    for (size_t g = 0; g < energy.size(); ++g) {
-      sum += energy[g];
-      if (std::abs(energy[g]) > most) {
-        most = std::abs(energy[g]);
-        which = static_cast<int>(g);
-      }
-    }
     // w'^2 = w^2 + x^T K_s x: the relative change of the frequency.
-    const double relative = std::sqrt(std::max(0.0, 1.0 + sum / eigenvalues[i])) - 1.0;
-    const double size = 1.0 + sum / eigenvalues[i] > 0.0 ? std::abs(relative)
-                                                         : std::numeric_limits<double>::infinity();
+    const double ratio = 1.0 + sum(energy) / eigenvalues[i];
+    const double size = ratio > 0.0 ? std::abs(std::sqrt(ratio) - 1.0) : kInf;
     if (size > worst) {
       worst = size;
       mode = static_cast<int>(i);
-      beam = which;
+      beam = largest(energy);
     }
   }
   if (!(worst > kAxialForceWarning) || beam < 0) return "";

@@ -1,16 +1,20 @@
 // What the beam law leaves out of an element's axial force (docs/model.md "Axial force and
 // bending"): the force acts along the frame the element's left end carries, not along its chord,
-// so an element has no stress stiffness of its own. The real force along the chord adds, per
-// element, a transverse force on its right end of -c N / l times the transverse offset xi_y, xi_z
-// of point 2 in that frame (and the opposite on its left end; c = kStringStiffnessFactor, N the
-// axial force, tension positive). Its effect on a result is measured, not guessed from the
-// element alone:
+// so in that frame an element has no stress stiffness of its own. The real force adds, per element
+// and bending plane, the consistent geometric stiffness of a cubic bending shape on the right
+// end's offset v and turn t in that frame (where the left end has neither):
+// N / (30 l) [36, -3 l; -3 l, 4 l^2], N the axial force (tension positive); in the x-y plane
+// v = xi_y, t = phi_z, in the x-z plane v = xi_z, t = -phi_y. Its effect on a result is measured,
+// not guessed from the element alone:
 //  - a static equilibrium: the correction e of the displacements that the missing forces g make,
 //    S e + g(q + e) = 0 (S the tangent of the wrenches; g linear in e), by a fixed-point iteration
-//    on the static analysis's factorization: e = -S^-1 (g0 + G e);
-//  - a mode (M-normalized shape x, w^2): the Rayleigh quotient's change, the relative frequency
-//    change 1/2 x^T K_s x / w^2 with K_s = -G the missing stiffness.
-// Segments reduce both as 1/n^2 (each element's share of the beam's bending shortens).
+//    on the static analysis's factorization, e = -S^-1 (g0 + G e); and whether the structure with
+//    the missing stiffness K_s = -G would be unstable (the lowest eigenvalue of K^-1 K_s at or
+//    below -1, K = -S), which a perfect column, with no offset to correct, shows only so;
+//  - a mode (M-normalized shape x, w^2): w'^2 = w^2 + x^T K_s x (Rayleigh);
+//  - a buckling factor (K0 x = lambda (-K1) x): the same quotient with the missing stiffness of
+//    the reference state and of the scaled loads per unit factor.
+// Segments reduce each as 1/n^2.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,20 +27,24 @@
 
 namespace beamrail {
 
-// c of -c N / l: the consistent geometric stiffness of a cubic bending shape (6/5 N/l), which
-// makes a cantilever's first-order stiffness 3 EI / L^3 (1 -+ 2/5 N L^2 / EI) exact
-// (docs/model.md).
-inline constexpr double kStringStiffnessFactor = 1.2;
 // The relative error of a result above which the analysis warns.
 inline constexpr double kAxialForceWarning = 0.01;
+// A static correction counts relative to its body's displacement along it, but at least this part
+// of the largest displacement of any body: a body that barely moves that way (the middle of a
+// strut loaded through its ends, 1e-5 of the frame's motion) is no result to warn of.
+inline constexpr double kAxialForceFloor = 0.01;
 
 // The missing forces of every beam element at the state in data.pose.
 class MissingAxialForces {
  public:
   MissingAxialForces(const Model& model, const Data& data);
+  // With the axial forces that the generalized displacement `direction` (n_dofs) adds to the
+  // state's, to first order (N = EA d xi_x / l): per unit of a buckling analysis's load factor.
+  MissingAxialForces(const Model& model, const Data& data, const Eigen::VectorXd& direction);
 
-  // Whether any element carries an axial force.
+  // Whether any element carries an axial force, and whether one is compressed.
   bool any() const { return !elements_.empty(); }
+  bool compressed() const;
 
   // The wrench vector (n_dofs, generalized forces on the free bodies) of the missing forces at
   // the state, g0.
@@ -49,7 +57,7 @@ class MissingAxialForces {
   // The scene beams (a split beam's segments together) and their element counts.
   const std::vector<std::string>& beam_names() const { return names_; }
   const std::vector<int>& beam_elements() const { return counts_; }
-  // Per scene beam: the largest |N| of its elements [N] and its sign (tension > 0).
+  // Per scene beam: the axial force of largest magnitude among its elements [N] (tension > 0).
   const std::vector<double>& beam_forces() const { return forces_; }
 
  private:
@@ -57,15 +65,22 @@ class MissingAxialForces {
     int free1 = -1, free2 = -1;  // free indices of the two bodies (-1: fixed)
     int beam = 0;                // the scene beam (names_)
     Mat3 e1;                     // the left end's frame, global
+    Mat3 t;                      // d phi / d (small rotation of the right end in that frame)
     Vec3 r2;                     // p2 - c2, global
     Vec3 lever1;                 // p2 - c1, global
-    Vec3 offset;                 // xi (point 2 in the left end's frame)
-    double k = 0.0;              // c N / l
+    Vec3 offset;                 // xi: point 2 in the left end's frame
+    Vec3 turn;                   // phi: the right end's rotation measure in that frame
+    double n = 0.0, l = 0.0;     // axial force [N], length [m]
   };
-  // d xi of the element for the generalized displacement v.
-  Vec3 offset_change(const Element& e, const Eigen::VectorXd& v) const;
-  // Adds the wrenches of a force f (global) on point 2 and -f on the left end to out.
-  void add(const Element& e, const Vec3& f, Eigen::VectorXd& out) const;
+  // The elements at the state, their axial forces from the state (direction: nullptr) or from
+  // the first-order change along *direction.
+  void build(const Model& model, const Data& data, const Eigen::VectorXd* direction);
+  // d xi and d phi of the element for the generalized displacement v.
+  void change(const Element& e, const Eigen::VectorXd& v, Vec3* dxi, Vec3* dphi) const;
+  // The missing forces f (conjugate to xi) and m (to phi) of offsets xi (y, z) and turns phi.
+  static void local_forces(const Element& e, const Vec3& xi, const Vec3& phi, Vec3* f, Vec3* m);
+  // Adds the generalized forces of (f, m) to out.
+  void add(const Element& e, const Vec3& f, const Vec3& m, Eigen::VectorXd& out) const;
 
   Eigen::Index n_ = 0;
   std::vector<Element> elements_;
@@ -74,25 +89,36 @@ class MissingAxialForces {
   std::vector<double> forces_;
 };
 
-// The relative change of a static equilibrium's displacements that the missing forces make
-// (largest translation of the correction over the largest translation from the initial
-// configuration), and per scene beam its share; `solve` applies S^-1 (the factorized tangent of
-// the wrenches at the state). Infinite when the iteration diverges (the left-out compression
-// would buckle the structure) or the state has not moved.
+// What the missing forces do to a static equilibrium; `solve` applies S^-1 (the factorized
+// tangent of the wrenches at the state).
 struct AxialForceEffect {
+  // Per free body, its correction over its displacement along the correction (at least
+  // kAxialForceFloor of the largest displacement of any body); the largest. Infinite when the
+  // fixed-point iteration diverges.
   double relative = 0.0;
-  int beam = -1;  // the scene beam whose missing forces do most of it (-1: none)
+  bool unstable = false;  // the structure with the missing stiffness would be unstable
+  int beam = -1;          // the scene beam whose missing stiffness it works against most
 };
 AxialForceEffect static_axial_force_effect(
     const Model& model, const Data& data, const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve);
 
-// The warning for a static equilibrium, "" below kAxialForceWarning.
+// The warning for a static equilibrium, "" when the effect is below kAxialForceWarning.
 std::string static_axial_force_warning(const MissingAxialForces& missing,
                                        const AxialForceEffect& effect);
 
-// The warning for the modes (M-normalized shapes, eigenvalues w^2): the mode whose frequency the
-// missing stiffness changes most, "" below kAxialForceWarning.
+// The warning for buckling factors (shapes x, factors lambda of K0 x = lambda (-K1) x, and
+// x^T K0 x): lambda' = (x^T K0 x + x^T Ks0 x) / (x^T K0 x / lambda - x^T Ks1 x), the factor it
+// changes most; "" below kAxialForceWarning.
+std::string buckling_axial_force_warning(const MissingAxialForces& reference,
+                                         const MissingAxialForces& per_factor,
+                                         const std::vector<Eigen::VectorXd>& shapes,
+                                         const std::vector<double>& factors,
+                                         const std::vector<double>& stiffness);
+
+// The warning for the modes (M-normalized shapes, eigenvalues w^2; others skipped: eigenvalue
+// <= 0): the mode whose frequency the missing stiffness changes most; "" below
+// kAxialForceWarning.
 std::string modal_axial_force_warning(const MissingAxialForces& missing,
                                       const std::vector<Eigen::VectorXd>& shapes,
                                       const std::vector<double>& eigenvalues);

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/analysis/axial_force_check.hpp"
 #include "core/analysis/buckling_path.hpp"
 #include "core/analysis/deadline.hpp"
 #include "core/model/forces.hpp"
@@ -254,6 +255,12 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
     const double length = characteristic_length(reference);
     const Eigen::Index n = reference.n_dofs;
     const BucklingMatrices matrices = buckling_matrices(reference, scaled, t, data);
+    // What the beam law leaves out of the elements' own axial forces, at the reference state
+    // and per unit factor (core/analysis/axial_force_check.hpp).
+    const MissingAxialForces missing_reference(reference, data);
+    const MissingAxialForces missing_per_factor(reference, data, matrices.u1);
+    std::vector<Eigen::VectorXd> shapes;
+    std::vector<double> factors, stiffness;
     if (!held_by_beams(reference)) {
       // Rails and free bodies may leave directions without stiffness that a Cholesky factor
       // still passes at rounding level: those have no modes of their own to lose.
@@ -324,6 +331,9 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
                           .col(0))) /
           phi.dot(k0 * phi);
       deadline.check();
+      shapes.push_back(phi);
+      factors.push_back(factor);
+      stiffness.push_back(phi.dot(k0 * phi));
       result.modes.push_back({factor, normalized_shape(phi, length), nonlinearity});
       if (nonlinearity > kBucklingNonlinearityLimit)
         result.warnings.push_back(
@@ -337,17 +347,19 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
                  nonlinearity));
     }
     result.ok = true;
+    if (std::string w = buckling_axial_force_warning(missing_reference, missing_per_factor, shapes,
+                                                     factors, stiffness);
+        !w.empty())
+      result.warnings.push_back(std::move(w));
     if (result.positive_factors < wanted) {
-      // An unsplit beam has no stress stiffness of its own, so it buckles in no mode.
+      // A beam in one element has no stress stiffness of its own, so it buckles in no mode.
       std::string unsplit;
-      for (const Beam& e : reference.beams)
-        if (e.segment == 0) {
-          unsplit = "; beam \"" + e.name +
+      for (size_t g = 0; g < missing_per_factor.beam_names().size() && unsplit.empty(); ++g)
+        if (missing_per_factor.beam_elements()[g] == 1 && missing_per_factor.beam_forces()[g] < 0.0)
+          unsplit = "; beam \"" + missing_per_factor.beam_names()[g] +
                     "\" is one element, which has no stress stiffness of its own and buckles "
                     "only as part of a chain (docs/model.md \"Axial force and bending\"): give "
                     "compressed beams \"segments\"";
-          break;
-        }
       result.warnings.push_back(
           "the scaled loads buckle the structure in " + std::to_string(result.positive_factors) +
           " mode(s) only (" + std::to_string(wanted) +

@@ -109,7 +109,12 @@ TEST_F(ExactGradients, GradientOptimizersReachCobylasOptimumOfTheTableFrameInFew
     EXPECT_LE(designs, 150);
     EXPECT_LT(designs, cobyla["designs_in_history"].get<int>() / 4);
     EXPECT_EQ(s["gradient"]["method"], "exact");
-    EXPECT_EQ(s["gradient"]["designs_with_exact_derivatives"].get<int>(), s["designs_simulated"]);
+    // Every design but those with warnings (infeasible: no derivatives wanted; the axial-force
+    // check warns of one on SLSQP's path, its slim struts' own sag 1.2 % off in 2 segments).
+    EXPECT_EQ(s["gradient"]["designs_with_exact_derivatives"].get<int>() +
+                  s["designs_with_warnings"].get<int>(),
+              s["designs_simulated"]);
+    EXPECT_LE(s["designs_with_warnings"].get<int>(), 1);
     EXPECT_EQ(s["gradient"]["designs_by_differences"], 0);
     for (const Json& c : s["best"]["constraints"]) {
       EXPECT_TRUE(c["satisfied"].get<bool>()) << c.dump();

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/analysis/axial_force_check.hpp"
+#include "core/analysis/buckling_analysis.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "tests/support/scenes.hpp"
@@ -27,16 +28,19 @@ constexpr double kSide = 100.0;  // [N]
 // the 50 kg head carries the inertia) clamped at z = 0 with a head at z = 2 under an axial
 // force `axial` (< 0: compression) and kSide along global y, its weak direction (the box's
 // height, 60 mm, lies along local z = global y).
-std::string column(double axial, int segments) {
+std::string column(double axial, int segments, double side = kSide, bool reversed = false) {
   return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 1}},
     "sections": {"box": {"shape": "box", "width": 0.08, "height": 0.06, "wall": 0.004}},
     "bodies": [{"name": "head", "mass": 50, "inertia": [0.5, 0.5, 0.5], "position": [0, 0, 2]}],
-    "beams": [{"name": "column", "body1": "ground", "body2": "head", "point1": [0, 0, 0],
-               "point2": [0, 0, 2], "point3": [1, 0, 0], "material": "steel", "section": "box",
-               "segments": )" +
-         std::to_string(segments) + R"(}],
+    "beams": [{"name": "column", )" +
+         std::string(reversed ? R"("body1": "head", "body2": "ground", "point1": [0, 0, 2],
+               "point2": [0, 0, 0], "point3": [1, 0, 2],)"
+                              : R"("body1": "ground", "body2": "head", "point1": [0, 0, 0],
+               "point2": [0, 0, 2], "point3": [1, 0, 0],)") +
+         R"( "material": "steel", "section": "box", "segments": )" + std::to_string(segments) +
+         R"(}],
     "loads": [{"type": "force", "body": "head", "value": [0, )" +
-         std::to_string(kSide) + ", " + std::to_string(axial) + "]}]}";
+         std::to_string(side) + ", " + std::to_string(axial) + "]}]}";
 }
 
 // The weak axis's EI: Iy = (w h^3 - wi hi^3) / 12.
@@ -76,8 +80,8 @@ double warned(const std::vector<std::string>& warnings, const std::string& after
 }
 
 // The static equilibrium, then its modes (about it).
-Solved solve(double axial, int segments) {
-  const Model model = testing::scene_from_json(column(axial, segments));
+Solved solve(double axial, int segments, bool reversed = false) {
+  const Model model = testing::scene_from_json(column(axial, segments, kSide, reversed));
   Data data(model);
   StaticOptions options;
   options.tolerance = 1e-12;
@@ -101,36 +105,102 @@ Solved solve(double axial, int segments) {
   return run;
 }
 
-// 60 kN of compression (0.78 of Euler's 77.25 kN) and 2 kN of tension. The static warning's
-// value is the correction of the displacements over the largest of them, measured by iterating
-// on the analysis's own factorization; here against the closed form's correction of the side
-// deflection over the head's displacement. The modal one is the lowest mode's relative change
-// by the Rayleigh quotient, against the frequency of 64 segments (converged to 2e-4 at 0.78 of
-// the buckling load: 32 segments differ from it by that).
+// 60 kN of compression (0.78 of Euler's 77.25 kN) and 2 kN of tension, the column's element(s)
+// from the ground up and from the head down (the left end turning with the head). The static
+// warning's value is each body's correction over its displacement along it, measured by
+// iterating on the analysis's own factorization; here against the closed form, relative to the
+// side deflection computed. The modal one is the lowest mode's relative change by the Rayleigh
+// quotient, against the frequency of 64 segments (converged to 2e-4 at 0.78 of the buckling
+// load: 32 segments differ from it by that).
 TEST(AxialForce, TheStaticAndModalAnalysesWarnWhatTheBeamsOwnAxialForcesLeaveOut) {
-  for (double axial : {-60e3, 2e3}) {
-    const double exact = exact_sway(axial);
-    const double converged = solve(axial, 64).frequency;
-    for (int segments : {0, 4, 8, 16}) {
-      const Solved run = solve(axial, segments);
-      const double error = std::abs(exact - run.sway) / run.moved;
-      const double frequency_error = std::abs(converged / run.frequency - 1.0);
-      std::printf(
-          "N %+.0f N, %2d segments: sway %.6e m (exact %.6e): error %.3g, warning's %.3g; "
-          "f1 %.6g Hz (64 segments: %.6g): error %.3g, warning's %.3g\n",
-          axial, segments, run.sway, exact, error, run.estimate, run.frequency, converged,
-          frequency_error, run.modal);
-      for (const auto& [what, truth, value] :
-           {std::tuple<const char*, double, double>{"static", error, run.estimate},
-            {"modal", frequency_error, run.modal}}) {
-        if (truth > 1.5 * kAxialForceWarning) {
-          ASSERT_GT(value, 0.0) << what << ": no warning at " << segments;
-          EXPECT_GT(value, 0.7 * truth) << what << " " << segments;
-          EXPECT_LT(value, 1.3 * truth) << what << " " << segments;
-        } else if (truth < 0.5 * kAxialForceWarning) {
-          EXPECT_EQ(value, -1.0) << what << ": a warning at " << segments;
+  for (bool reversed : {false, true})
+    for (double axial : {-60e3, 2e3}) {
+      const double exact = exact_sway(axial);
+      const double converged = solve(axial, 64, reversed).frequency;
+      for (int segments : {0, 4, 8, 16}) {
+        const Solved run = solve(axial, segments, reversed);
+        const double error = std::abs(exact / run.sway - 1.0);
+        const double frequency_error = std::abs(converged / run.frequency - 1.0);
+        std::printf(
+            "%s, N %+.0f N, %2d segments: sway %.6e m (exact %.6e): error %.3g, "
+            "warning's %.3g; f1 %.6g Hz (64 segments: %.6g): error %.3g, warning's %.3g\n",
+            reversed ? "from the head" : "from the ground", axial, segments, run.sway, exact, error,
+            run.estimate, run.frequency, converged, frequency_error, run.modal);
+        for (const auto& [what, truth, value] :
+             {std::tuple<const char*, double, double>{"static", error, run.estimate},
+              {"modal", frequency_error, run.modal}}) {
+          if (truth > 1.5 * kAxialForceWarning) {
+            ASSERT_GT(value, 0.0) << what << ": no warning at " << segments;
+            EXPECT_GT(value, 0.7 * truth) << what << " " << segments;
+            EXPECT_LT(value, 1.3 * truth) << what << " " << segments;
+          } else if (truth < 0.5 * kAxialForceWarning) {
+            EXPECT_EQ(value, -1.0) << what << ": a warning at " << segments;
+          }
         }
       }
+    }
+}
+
+// A perfect column (no side load) at 1.2 times its Euler load: in one element it stands, with
+// nothing sideways to correct; 64 segments find it unstable. The static analysis says it would
+// buckle.
+TEST(AxialForce, APerfectColumnPastItsBucklingLoadIsReportedUnstable) {
+  const double euler = M_PI * M_PI * weak_ei() / (4.0 * kLength * kLength);
+  for (int segments : {0, 64}) {
+    const Model model = testing::scene_from_json(column(-1.2 * euler, segments, 0.0));
+    Data data(model);
+    const StaticResult result = solve_static(model, StaticOptions{}, data);
+    std::string text;
+    for (const std::string& w : result.warnings)
+      if (w.find("axial forces") != std::string::npos) text = w;
+    std::printf("%2d segments: %s; %s\n", segments, result.ok ? "ok" : result.message.c_str(),
+                text.c_str());
+    if (segments == 0) {
+      ASSERT_TRUE(result.ok) << result.message;
+      EXPECT_NE(text.find("would make this equilibrium unstable"), std::string::npos) << text;
+    } else {
+      EXPECT_FALSE(result.ok);
+      EXPECT_NE(result.message.find("unstable"), std::string::npos) << result.message;
+    }
+  }
+}
+
+// The buckling factor of 1 kN of compression against Euler's pi^2 EI / (4 L^2) = 77.25 kN: each
+// element leaves out its own stress stiffness, so segments converge from above; the warning's
+// value (the Rayleigh quotient with the missing stiffness of the forces per unit factor) against
+// the factor's error. One element finds no factor and says why.
+TEST(AxialForce, BucklingWarnsWhatTheBeamsOwnAxialForcesLeaveOut) {
+  const double euler = M_PI * M_PI * weak_ei() / (4.0 * kLength * kLength) / 1000.0;
+  for (int segments : {0, 2, 4, 8, 16, 32}) {
+    const Model model = testing::scene_from_json(column(-1000.0, segments, 0.0));
+    Data data(model);
+    const Model reference = with_loads(
+        model, [](const Load&) { return false; }, false);
+    BucklingOptions options;
+    options.modes = 1;
+    const BucklingResult result = solve_buckling(reference, model, options, data);
+    ASSERT_TRUE(result.ok) << result.message;
+    std::string text;
+    const double value = warned(result.warnings, "by about ", &text);
+    if (segments == 0) {
+      ASSERT_TRUE(result.modes.empty());
+      bool named = false;
+      for (const std::string& w : result.warnings)
+        named = named || w.find("beam \"column\" is one element") != std::string::npos;
+      EXPECT_TRUE(named);
+      continue;
+    }
+    ASSERT_FALSE(result.modes.empty());
+    const double factor = result.modes[0].factor;
+    const double error = std::abs(euler / factor - 1.0);
+    std::printf("%2d segments: factor %.6g (Euler %.6g): error %.3g, warning's %.3g\n", segments,
+                factor, euler, error, value);
+    if (error > 1.5 * kAxialForceWarning) {
+      ASSERT_GT(value, 0.0) << "no warning at " << segments << ": " << text;
+      EXPECT_GT(value, 0.7 * error) << segments;
+      EXPECT_LT(value, 1.3 * error) << segments;
+    } else if (error < 0.5 * kAxialForceWarning) {
+      EXPECT_EQ(value, -1.0) << "a warning at " << segments << ": " << text;
     }
   }
 }

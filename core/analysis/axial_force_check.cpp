@@ -53,6 +53,31 @@ double sum(const std::vector<double>& values) {
   return s;
 }
 
+// The largest relative change of a mode's frequency or a buckling factor, and where.
+struct Worst {
+  double size = 0.0;
+  int mode = -1, beam = -1;
+  void offer(double change, size_t i, const std::vector<double>& energy) {
+    if (!(change > size)) return;
+    size = change;
+    mode = static_cast<int>(i);
+    beam = largest(energy);
+  }
+  // "the axial forces of the beams change <what> N by about X of it ...", or with `infinite`
+  // (its %d the mode's number) where the change has no size; "" below kAxialForceWarning.
+  std::string worded(const char* what, const char* infinite,
+                     const MissingAxialForces& missing) const {
+    if (!(size > kAxialForceWarning) || beam < 0) return "";
+    char text[300];
+    if (std::isfinite(size))
+      std::snprintf(text, sizeof text, "change %s %d by about %.3g of it", what, mode + 1, size);
+    else
+      std::snprintf(text, sizeof text, infinite, mode + 1);
+    return "the axial forces of the beams " + std::string(text) + " beyond what the model holds, " +
+           advice(missing, beam, size);
+  }
+};
+
 }  // namespace
 
 MissingAxialForces::MissingAxialForces(const Model& model, const Data& data) : n_(model.n_dofs) {
@@ -284,68 +309,36 @@ std::string buckling_axial_force_warning(const MissingAxialForces& reference,
                                          const std::vector<double>& factors,
                                          const std::vector<double>& stiffness) {
   if (!reference.any() && !per_factor.any()) return "";
-  double worst = 0.0;
-  int mode = -1, beam = -1;
+  Worst worst;
   for (size_t i = 0; i < shapes.size(); ++i) {
     if (!(factors[i] > 0.0) || !(stiffness[i] > 0.0)) continue;
     const std::vector<double> e1 = per_factor.stiffness_energy(shapes[i]);
     const double numerator = stiffness[i] + sum(reference.stiffness_energy(shapes[i]));
     const double denominator = stiffness[i] / factors[i] - sum(e1);
-    const double size = denominator > 0.0 && numerator > 0.0
-                            ? std::abs(numerator / denominator / factors[i] - 1.0)
-                            : kInf;
-    if (size > worst) {
-      worst = size;
-      mode = static_cast<int>(i);
-      beam = largest(e1);
-    }
+    worst.offer(denominator > 0.0 && numerator > 0.0
+                    ? std::abs(numerator / denominator / factors[i] - 1.0)
+                    : kInf,
+                i, e1);
   }
-  if (!(worst > kAxialForceWarning) || beam < 0) return "";
-  char text[300];
-  if (std::isfinite(worst))
-    std::snprintf(text, sizeof text,
-                  "the axial forces of the beams change buckling factor %d by about %.3g of it "
-                  "beyond what the model holds, ",
-                  mode + 1, worst);
-  else
-    std::snprintf(text, sizeof text,
-                  "the axial forces of the beams leave buckling factor %d without meaning (the "
-                  "stiffness they leave out outweighs the shape's) beyond what the model holds, ",
-                  mode + 1);
-  return text + advice(per_factor, beam, worst);
+  return worst.worded("buckling factor",
+                      "leave buckling factor %d without meaning (the stiffness they leave out "
+                      "outweighs the shape's)",
+                      per_factor);
 }
 
 std::string modal_axial_force_warning(const MissingAxialForces& missing,
                                       const std::vector<Eigen::VectorXd>& shapes,
                                       const std::vector<double>& eigenvalues) {
   if (!missing.any()) return "";
-  double worst = 0.0;
-  int mode = -1, beam = -1;
+  Worst worst;
   for (size_t i = 0; i < shapes.size(); ++i) {
     if (!(eigenvalues[i] > 0.0)) continue;
     const std::vector<double> energy = missing.stiffness_energy(shapes[i]);
     // w'^2 = w^2 + x^T K_s x: the relative change of the frequency.
     const double ratio = 1.0 + sum(energy) / eigenvalues[i];
-    const double size = ratio > 0.0 ? std::abs(std::sqrt(ratio) - 1.0) : kInf;
-    if (size > worst) {
-      worst = size;
-      mode = static_cast<int>(i);
-      beam = largest(energy);
-    }
+    worst.offer(ratio > 0.0 ? std::abs(std::sqrt(ratio) - 1.0) : kInf, i, energy);
   }
-  if (!(worst > kAxialForceWarning) || beam < 0) return "";
-  char text[300];
-  if (std::isfinite(worst))
-    std::snprintf(text, sizeof text,
-                  "the axial forces of the beams change the frequency of mode %d by about %.3g "
-                  "of it beyond what the model holds, ",
-                  mode + 1, worst);
-  else
-    std::snprintf(text, sizeof text,
-                  "the axial forces of the beams would make mode %d unstable beyond what the "
-                  "model holds, ",
-                  mode + 1);
-  return text + advice(missing, beam, worst);
+  return worst.worded("the frequency of mode", "would make mode %d unstable", missing);
 }
 
 }  // namespace beamrail

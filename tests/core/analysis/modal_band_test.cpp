@@ -276,6 +276,29 @@ double inertia_warning_estimate(const TransientRun& run) {
   return -1.0;
 }
 
+// The ramped heavy tip under `load`, by `method` with the band chosen for rtol, and its error
+// against the full modal model at rtol 1e-10 (which bdf at rtol 1e-10 meets to 4e-10 of the
+// motion).
+struct BandedRun {
+  TransientRun run;
+  double error = 0.0;
+};
+BandedRun banded_heavy_tip(double load, IntegratorMethod method, double rtol) {
+  const Model model = scene_from_json(ramped_heavy_tip(load));
+  TransientOptions o = options(1.0, 5e-3, 1e-10, 1e-12);
+  o.integrator.method = IntegratorMethod::kModal;
+  const TransientRun full = simulate(model, o);
+  EXPECT_TRUE(full.result.ok) << full.result.message;
+  o = options(1.0, 5e-3, rtol, 1e-3 * rtol);
+  o.integrator.method = method;
+  o.integrator.choose_band = true;
+  BandedRun banded{simulate(model, o)};
+  EXPECT_TRUE(banded.run.result.ok) << banded.run.result.message;
+  EXPECT_GT(banded.run.result.max_frequency_hz, 0.0) << "not band-limited (at first)";
+  banded.error = motion_error(banded.run, full, testing::body_index(model, "tip"));
+  return banded;
+}
+
 // Measured against the full modal model at rtol 1e-10 (which bdf at rtol 1e-10 meets to 4e-10 of
 // the motion): at 1 N (slopes of 3e-3) a 37 Hz band left 17 rtol, estimated at 56 rtol; at 0.1 N
 // 0.18 rtol and no warning (estimated at 0.6 rtol). Before the estimate, the run said ok and
@@ -283,19 +306,7 @@ double inertia_warning_estimate(const TransientRun& run) {
 TEST(ModalBand, ARunWarnsWhenTheModesItKeepsQuasiStaticCarryInertia) {
   const double rtol = 1e-6;
   for (double load : {0.1, 1.0}) {
-    const Model model = scene_from_json(ramped_heavy_tip(load));
-    const int tip = testing::body_index(model, "tip");
-    TransientOptions o = options(1.0, 5e-3, 1e-10, 1e-12);
-    o.integrator.method = IntegratorMethod::kModal;
-    const TransientRun full = simulate(model, o);
-    ASSERT_TRUE(full.result.ok) << full.result.message;
-    o = options(1.0, 5e-3, rtol, 1e-3 * rtol);
-    o.integrator.method = IntegratorMethod::kModal;
-    o.integrator.choose_band = true;
-    const TransientRun banded = simulate(model, o);
-    ASSERT_TRUE(banded.result.ok) << banded.result.message;
-    ASSERT_GT(banded.result.max_frequency_hz, 0.0) << "not band-limited";
-    const double error = motion_error(banded, full, tip);
+    const auto [banded, error] = banded_heavy_tip(load, IntegratorMethod::kModal, rtol);
     const double estimate = inertia_warning_estimate(banded);
     std::printf("modal, %.1f N: band %.4g Hz, error %.2e (%.2f rtol), warning's estimate %.2e\n",
                 load, banded.result.max_frequency_hz, error, error / rtol, estimate);
@@ -317,19 +328,7 @@ TEST(ModalBand, ARunWarnsWhenTheModesItKeepsQuasiStaticCarryInertia) {
 TEST(ModalBand, AutoIntegratesEveryModeOnceTheChosenBandsQuasiStaticModesCarryInertia) {
   const double rtol = 1e-6;
   for (double load : {0.1, 1.0}) {
-    const Model model = scene_from_json(ramped_heavy_tip(load));
-    const int tip = testing::body_index(model, "tip");
-    TransientOptions o = options(1.0, 5e-3, 1e-10, 1e-12);
-    o.integrator.method = IntegratorMethod::kModal;
-    const TransientRun full = simulate(model, o);
-    ASSERT_TRUE(full.result.ok) << full.result.message;
-    o = options(1.0, 5e-3, rtol, 1e-3 * rtol);
-    o.integrator.method = IntegratorMethod::kAuto;
-    o.integrator.choose_band = true;
-    const TransientRun run = simulate(model, o);
-    ASSERT_TRUE(run.result.ok) << run.result.message;
-    ASSERT_GT(run.result.max_frequency_hz, 0.0) << "not band-limited at first";
-    const double error = motion_error(run, full, tip);
+    const auto [run, error] = banded_heavy_tip(load, IntegratorMethod::kAuto, rtol);
     const std::vector<MethodPhase>& phases = run.result.phases;
     std::printf("auto, %.1f N: band %.4g Hz, %zu phases, error %.2e (%.2f rtol)\n", load,
                 run.result.max_frequency_hz, phases.size(), error, error / rtol);

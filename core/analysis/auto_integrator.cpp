@@ -48,9 +48,10 @@ class AutoIntegrator : public Integrator {
       return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the scene has no free body",
                             error);
     // A moving support leaves any one linearization: an A-stable implicit method, whose steps the
-    // undamped axial modes of a spinning beam do not hold down. On studies/spin_up.json (30 s,
-    // rtol 1e-7) bdf took 582k steps (13.4 s: its higher orders are unstable for them), ESDIRK547
-    // 45k (4.9 s, 6e-5 off a tight run), the default DIRK table 12k (3.2 s, 1e-7 off).
+    // undamped axial modes of a spinning beam do not hold down. On studies/spin_up.json (10
+    // segments, 30 s, rtol 1e-7) bdf took 582k steps (13.4 s: its higher orders are unstable for
+    // them), ESDIRK547 45k (4.9 s, 6e-5 off a tight run), the default DIRK table 12k (3.2 s, 1e-7
+    // off).
     if (!model.driven_bodies.empty())
       return start_implicit(IntegratorMethod::kDirk, "", 0.0, y0,
                             "body \"" + model.bodies[model.driven_bodies.front()].name +

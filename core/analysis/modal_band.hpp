@@ -35,7 +35,7 @@
 // motion; tests/core/analysis/transient_auto_test.cpp); a smooth load's is not reduced. The
 // nonlinear forcing is not in it: the modal method is for motions near its linearization (what
 // the quasi-static modes then miss, their inertia, is checked during the run:
-// core/analysis/modal_integrator.cpp, check_quasi_static_inertia). The band
+// core/analysis/quasi_static_modes.hpp). The band
 // is the smallest number of modes (never splitting a cluster of equal frequencies, never leaving
 // out a rigid or mechanism mode) whose estimate is at most the tolerance. An estimate, not a bound:
 // on a cantilever (tests/core/analysis/modal_band_test.cpp) the bands chosen for rtol 1e-3 .. 1e-6

@@ -1,7 +1,5 @@
 #include "core/analysis/modal_integrator.hpp"
 
-#include <Eigen/LU>
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +11,7 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/modal_band.hpp"
 #include "core/analysis/modal_reference.hpp"
+#include "core/analysis/quasi_static_modes.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/model/dynamics.hpp"
 #include "core/model/forces.hpp"
@@ -33,14 +32,6 @@ using Block = ModeBlock;
 void multiply(const Eigen::MatrixXd& a, const Block& b, Block& out) {
   out.resize(a.rows(), 2);
   multiply_pair(a, b.data(), out.data());
-}
-
-// out -= a b for a vector b (one pass over a; work: a.rows() doubles of work space).
-void subtract_product(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, Eigen::VectorXd& work,
-                      Eigen::VectorXd& out) {
-  work.resize(a.rows());
-  multiply_vector(a, b.data(), work.data());
-  out -= work;
 }
 
 // set_inertia_limit applies from this angle of the band's slowest elastic mode on [rad].
@@ -134,7 +125,7 @@ class ModalExponential : public Integrator {
         have_n0_ = flag == kOk;
         if (have_n0_) {
           flag = reached;
-          quasi_static_rate();
+          quasi_.compute_rate(StepFunctions::c[StepFunctions::kStages - 1]);
         }
       } catch (const std::exception& e) {
         context_->callback_error = e.what();
@@ -149,8 +140,7 @@ class ModalExponential : public Integrator {
   void restart(double t, N_Vector y) override {
     t_ = t;
     have_n0_ = false;
-    rate_known_ = false;
-    last_step_ = 0.0;
+    quasi_.restart();
     from_states(N_VGetArrayPointer(y));
   }
 
@@ -266,20 +256,10 @@ class ModalExponential : public Integrator {
       lambda_(i) = phi_.col(i).dot(k0 * phi_.col(i)) / phi_.col(i).dot(m0_ * phi_.col(i));
     reduced_ = m_ < n_;
     if (!reduced_) return true;
-    for (Eigen::Index i = 0; i < m_; ++i)
-      if (lambda_(i) > 1e-12 * lambda_.maxCoeff() &&
-          (lowest_elastic_ < 0.0 || lambda_(i) < lowest_elastic_))
-        lowest_elastic_ = lambda_(i);
-    // Shifted by a hundredth of the band's w^2 so that rigid-body and mechanism modes (in the
-    // band) leave it regular: the iteration's fixed point (no acceleration outside the band) is
-    // the same; its contraction is at most shift_ / w^2 of the band.
-    shift_ = 0.01 * limit;
-    k0_.compute(Eigen::SparseMatrix<double>(k0 + shift_ * m0_));
-    if (k0_.info() != Eigen::Success || !(k0_.vectorD().array() > 0.0).all())
+    if (!quasi_.init(k0, m0_, phi_, lambda_, limit))
       return fail(error,
                   "a band-limited run (max_frequency_hz): the stiffness where it is linearized "
                   "has a mode of negative stiffness below the band's");
-    y_ = Eigen::VectorXd::Zero(n_);
     return true;
   }
 
@@ -293,19 +273,8 @@ class ModalExponential : public Integrator {
   // One Newton correction of the quasi-static part: y += R M0 a, with Psi^T a given (psi_a);
   // returns its size in the error weights at x.
   double correct(const Eigen::VectorXd& psi_a, Block& x) {
-    work_n_ = m0_ * acceleration_;
-    Eigen::VectorXd dy = k0_.solve(work_n_);
-    if (updated_) {
-      // With the tangent K of a later state: dy = K^-1 (M0 a - Psi l), Psi^T dy = 0.
-      psi_a_work_.resize(m_);
-      project(dy, psi_a_work_.data());
-      work_m_ = schur_.solve(psi_a_work_);
-      subtract_product(kinv_psi_, work_m_, work_n_, dy);
-    } else {
-      work_m_ = psi_a.array() / (lambda_ + shift_);
-      subtract_product(phi_, work_m_, work_n_, dy);
-    }
-    y_ += dy;
+    m0_a_.noalias() = m0_ * acceleration_;
+    const Eigen::VectorXd& dy = quasi_.correct(m0_a_, psi_a);
     x.col(0) += dy;
     double sum = 0.0;
     for (size_t b = 0; b < c0_.size(); ++b)
@@ -328,16 +297,8 @@ class ModalExponential : public Integrator {
     set_state(model, data, y13_.data());
     compute_wrenches(model, data, context_->force_time(t_));
     compute_tangent(model, data, context_->force_time(t_), false);
-    Eigen::SparseMatrix<double> k = -stiffness_matrix(model, data);
-    k = 0.5 * Eigen::SparseMatrix<double>(k + Eigen::SparseMatrix<double>(k.transpose()));
-    k0_.factorize(Eigen::SparseMatrix<double>(k + shift_ * m0_));
     ++stats_.jacobian_evaluations;
-    if (k0_.info() != Eigen::Success || !(k0_.vectorD().array() > 0.0).all()) return false;
-    const Eigen::MatrixXd psi = m0_ * phi_;
-    kinv_psi_ = k0_.solve(psi);
-    schur_.compute(psi.transpose() * kinv_psi_);
-    updated_ = true;
-    return true;
+    return quasi_.update_tangent(-stiffness_matrix(model, data));
   }
 
   // z from the 13 states of every free body.
@@ -350,8 +311,8 @@ class ModalExponential : public Integrator {
     multiply(phi_, z_, x_);
     if (reduced_) {
       // The part outside the band as a first guess of the quasi-static one.
-      y_ = x.col(0) - x_.col(0);
-      x_.col(0) += y_;
+      quasi_.y() = x.col(0) - x_.col(0);
+      x_.col(0) += quasi_.y();
     }
   }
 
@@ -398,26 +359,13 @@ class ModalExponential : public Integrator {
   // The accepted state (a rotation past the limit is reported by the next step that uses it),
   // with the quasi-static part's rate in the velocities when known.
   void to_states(double* y) {
-    if (!(reduced_ && rate_known_)) {
+    if (!(reduced_ && quasi_.rate_known())) {
       states_of(x_, y, false);
       return;
     }
     Block x = x_;
-    x.col(1) += y_rate_;
+    x.col(1) += quasi_.rate();
     states_of(x, y, false);
-  }
-
-  // dy/dt at the accepted state, from y at the last step's start, at its last stage (c h in) and
-  // at its end (y_, converged): the derivative of the parabola through them, second order in h.
-  // The band's velocities leave it out (y is not a state of the method), so that a run handed on
-  // to another method (auto: every mode) would otherwise start with the quasi-static part at
-  // rest and ring the modes above the band.
-  void quasi_static_rate() {
-    if (!(last_step_ > 0.0)) return;
-    const double c = StepFunctions::c[StepFunctions::kStages - 1], h = last_step_;
-    y_rate_ = ((1.0 - c) / (c * h)) * y_begin_ - (1.0 / (c * (1.0 - c) * h)) * y_stage_ +
-              ((2.0 - c) / ((1.0 - c) * h)) * y_;
-    rate_known_ = true;
   }
 
   // The accelerations (dv/dt, d^2 theta/dt^2) into acceleration_ at the physical state x whose
@@ -486,7 +434,6 @@ class ModalExponential : public Integrator {
         break;
       }
       last_size = size;
-      ++corrections_;
     }
     out.col(1).array() += lambda_ * z.col(0).array();
     return true;
@@ -505,7 +452,7 @@ class ModalExponential : public Integrator {
         apply_add(f.a[i][j], lambda_, stage_n_[j], stage_z_, f.h);
       }
       multiply(phi_, stage_z_, xi_);
-      if (reduced_) xi_.col(0) += y_;
+      if (reduced_) xi_.col(0) += quasi_.y();
       if (!nonlinear(t + StepFunctions::c[i] * f.h, stage_z_, xi_, stage_n_[i], flag)) return false;
     }
     out.setZero(m_, 2);
@@ -576,7 +523,7 @@ class ModalExponential : public Integrator {
       if (!have_n0_ && !nonlinear(t_, z_, x_, n0_, &flag)) return fail_flag(flag);
       have_n0_ = true;
       const Block& n0 = n0_;
-      if (reduced_) y_start_ = y_;  // the quasi-static part at the accepted state
+      if (reduced_) quasi_.begin_step();  // the quasi-static part at the accepted state
       if (h_ <= 0.0) h_ = options_.initial_step > 0.0 ? options_.initial_step : (target - t_);
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
@@ -585,7 +532,7 @@ class ModalExponential : public Integrator {
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
         full_.compute(h, lambda_);
-        if (reduced_) y_ = y_start_;  // not a rejected trial's
+        if (reduced_) quasi_.restore();  // not a rejected trial's
         Block& next = next_;
         int sflag = kOk;
         const bool ok = step(full_, t_, z_, n0, next, &sflag);
@@ -632,8 +579,8 @@ class ModalExponential : public Integrator {
           z_.swap(next);
           x_.swap(x_next_);
           if (reduced_) {
-            x_.col(0) += y_;
-            check_quasi_static_inertia(h);
+            x_.col(0) += quasi_.y();
+            quasi_.accepted(h, StepFunctions::c[StepFunctions::kStages - 1], z_.col(1));
           }
           have_n0_ = false;
           ++stats_.steps;
@@ -650,39 +597,8 @@ class ModalExponential : public Integrator {
     }
   }
 
-  // A band-limited run drops the kinetic energy of its quasi-static part y (their dynamics):
-  // what the linear estimate of the band (modal_band.hpp) leaves out is the part the motion
-  // drives at second order, a stiff mode pulled along by the deflection (a heavy tip's axial
-  // motion as a cantilever bends: its inertia stiffens the bending). Dropped, the motion's
-  // frequencies are off by half the ratio of that energy to the band's (Rayleigh's quotient),
-  // and its phase drifts by that times w t. After each accepted step: the largest |dy/dt|^2_M0
-  // (from y at the step's start and at its last stage) and the largest |nu|^2 (twice the band's
-  // kinetic energy); half their ratio times the lowest elastic w in the band times the time run
-  // (at least 1) estimates the drift relative to the motion (quasi_static_inertia); above rtol
-  // the run warns (closing_warnings). Keeping those modes' inertia instead (y's second
-  // difference subtracted in the iteration) was tried: lagged, it drove the modes above the band
-  // and the runs diverged or erred more.
-  void check_quasi_static_inertia(double h) {
-    // y_ is the last stage's, at c h into the step.
-    work_n_ = (y_ - y_start_) / (StepFunctions::c[StepFunctions::kStages - 1] * h);
-    y_begin_ = y_start_;
-    y_stage_ = y_;
-    last_step_ = h;
-    rate_known_ = false;
-    quasi_static_kinetic_ = std::max(quasi_static_kinetic_, work_n_.dot(m0_ * work_n_));
-    band_kinetic_ = std::max(band_kinetic_, z_.col(1).squaredNorm());
-  }
-
  public:
-  QuasiStaticInertia quasi_static_inertia() const {
-    QuasiStaticInertia q;
-    q.band_hz = band_hz_;
-    q.t = t_;
-    if (!(band_kinetic_ > 0.0)) return q;
-    q.ratio = quasi_static_kinetic_ / band_kinetic_;
-    q.drift = 0.5 * q.ratio * std::max(1.0, std::sqrt(std::max(0.0, lowest_elastic_)) * (t_ - t0_));
-    return q;
-  }
+  QuasiStaticInertia quasi_static_inertia() const { return quasi_.inertia(band_hz_, t_, t_ - t0_); }
 
   // advance() stops (kInertia) after the step whose drift first passes `drift` (0: never), once
   // inertia_settled().
@@ -692,9 +608,7 @@ class ModalExponential : public Integrator {
   // Before, a load that starts from rest gives a ratio of kinetic energies far above the
   // motion's: the quasi-static part follows the load at once, the band only over about a third
   // of its period (the heavy tip's smooth ramp: 9e-5 at 5 ms, 1e-7 at 2 rad, 5e-8 from then on).
-  bool inertia_settled() const {
-    return !(lowest_elastic_ > 0.0) || std::sqrt(lowest_elastic_) * (t_ - t0_) >= kInertiaSettling;
-  }
+  bool inertia_settled() const { return quasi_.settled(t_ - t0_, kInertiaSettling); }
 
   bool band_limited() const { return reduced_; }
 
@@ -721,25 +635,17 @@ class ModalExponential : public Integrator {
   OdeContext* context_ = nullptr;
   Eigen::Index n_ = 0;  // degrees of freedom
   Eigen::Index m_ = 0;  // modes integrated (n_ unless band-limited)
-  // Band-limited (m_ < n_): the modes above the band are quasi-static, x = Phi z + y with
-  // no acceleration outside the band (quasi-static), solved by the Newton iteration
-  // y <- y + R M0 a(Phi z + y) with R = (K0 + mu M0)^-1 - Phi (Lambda + mu)^-1 Phi^T the
-  // residual flexibility (mu = shift_).
+  // Band-limited (m_ < n_): the modes above the band are quasi-static, x = Phi z + y
+  // (core/analysis/quasi_static_modes.hpp).
   bool reduced_ = false;
+  QuasiStaticModes quasi_;
   Eigen::SparseMatrix<double> m0_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> k0_;  // of K0 + mu M0, or a later K
-  bool updated_ = false;      // k0_ holds a later tangent (then kinv_psi_, schur_)
-  Eigen::MatrixXd kinv_psi_;  // K^-1 Psi
-  Eigen::PartialPivLU<Eigen::MatrixXd> schur_;  // of Psi^T K^-1 Psi
-  Eigen::VectorXd y_;                           // the quasi-static part of the latest evaluation
-  Eigen::VectorXd work_n_, work_m_, psi_a_, psi_a_work_;
-  Block n0_;  // N at the accepted state, when have_n0_
+  Eigen::VectorXd m0_a_, psi_a_;  // work space: M0 a, Phi^T M0 a
+  Block n0_;                      // N at the accepted state, when have_n0_
   bool have_n0_ = false;
   double band_hz_ = 0.0;          // the highest frequency integrated [Hz]
   double band_estimate_ = -1.0;   // a chosen band's estimated error (modal_band.hpp); -1: given
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
-  double shift_ = 0.0;            // of K0 + shift M0 in the quasi-static iteration [1/s^2]
-  long corrections_ = 0;          // evaluations spent on the quasi-static iteration
   Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
   Eigen::VectorXd m0_v_;          // work space of project
   Eigen::ArrayXd lambda_;
@@ -751,15 +657,6 @@ class ModalExponential : public Integrator {
   // A trial step's new state and its two error estimates side by side, modal and physical.
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
   Block stage_z_, next_, difference_;  // work space: a stage's modal state, a trial step, errors
-  Eigen::VectorXd y_start_;            // work space: the quasi-static part at the accepted state
-  // The last accepted step's y at its start and at its last stage, and its size (0: none since
-  // the start or a restart); the rate of y at the accepted state when rate_known_.
-  Eigen::VectorXd y_begin_, y_stage_, y_rate_;
-  double last_step_ = 0.0;
-  bool rate_known_ = false;
-  double quasi_static_kinetic_ = 0.0;  // check_quasi_static_inertia: the largest |dy/dt|^2_M0
-  double band_kinetic_ = 0.0;          // and |nu|^2 so far
-  double lowest_elastic_ = -1.0;       // the lowest elastic w^2 in the band (-1: none)
   double inertia_limit_ = 0.0;         // set_inertia_limit
   std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote
   Eigen::VectorXd acceleration_;   // work space: the physical accelerations of a stage

@@ -80,7 +80,7 @@ bool modal_spectrum(const Integrator& integrator, double* smallest_positive, dou
 std::string modal_band_choice(const Integrator& integrator);
 
 // What a band-limited modal run drops with the kinetic energy of the modes it keeps
-// quasi-static (core/analysis/modal_integrator.cpp, check_quasi_static_inertia).
+// quasi-static (core/analysis/quasi_static_modes.hpp).
 struct QuasiStaticInertia {
   double band_hz = 0.0;  // the band's top [Hz]
   double ratio = 0.0;    // their largest kinetic energy over the band's largest

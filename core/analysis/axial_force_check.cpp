@@ -5,10 +5,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/model/beam.hpp"
 #include "core/model/element_kinematics.hpp"
-#include "core/model/rail.hpp"
-#include "core/model/stiffness.hpp"
 
 namespace beamrail {
 namespace {
@@ -22,24 +19,20 @@ int segments_for(int elements, double relative) {
   return static_cast<int>(std::ceil(elements * std::sqrt(relative / kAxialForceWarning)));
 }
 
-// What to do about beam `name` (n elements, its largest axial force `force`), whose missing
-// stiffness makes an error `relative`.
-std::string advice(const std::string& name, int n, double force, double relative) {
+std::string advice(const MissingAxialForces& missing, int beam, double relative) {
+  const int n = missing.beam_elements()[beam];
+  const double force = missing.beam_forces()[beam];
   const int needed = segments_for(n, relative);
   const std::string more =
       needed > n ? "; more segments reduce it as 1/n^2 (\"segments\": " + std::to_string(needed) +
                        " for 1 %)"
                  : "";
-  return "mostly beam \"" + name + "\" (" + (force < 0.0 ? "compressed, " : "stretched, ") +
-         std::to_string(n) + (n == 1 ? " element" : " elements") +
+  return "mostly beam \"" + missing.beam_names()[beam] + "\" (" +
+         (force < 0.0 ? "compressed, " : "stretched, ") + std::to_string(n) +
+         (n == 1 ? " element" : " elements") +
          "): the beam law leaves out what an element's own axial force does to its bending (no "
          "P-delta within an element: docs/model.md \"Axial force and bending\")" +
          more;
-}
-
-std::string advice(const MissingAxialForces& missing, int beam, double relative) {
-  return advice(missing.beam_names()[beam], missing.beam_elements()[beam],
-                missing.beam_forces()[beam], relative);
 }
 
 // The largest of per-scene-beam values by magnitude; -1 when all are 0.
@@ -85,25 +78,6 @@ struct Worst {
   }
 };
 
-// d^T K_b d of every rail at the state in data.pose: the bending part of its law's stiffness on
-// its offset and turn (a rail's bending holds a motion as a beam's does).
-double rail_bending(const Model& model, const Data& data) {
-  double total = 0.0;
-  for (const Rail& r : model.rails) {
-    if (model.bodies[r.ends.body1].free_index < 0 && model.bodies[r.ends.body2].free_index < 0)
-      continue;
-    const ElementFrames<double> f = element_frames(r.ends, data.pose[r.ends.body1],
-                                                   data.pose[r.ends.body2], rotation_measure(r));
-    bool floored = false;
-    const double l = rail_length(r, f.xi(0), &floored);
-    const StiffnessBlocks<double> k = rail_stiffness(r, f.xi(0), l, floored);
-    Vec6 d;
-    d << 0.0, f.xi(1), f.xi(2), 0.0, f.phi(1), f.phi(2);
-    total += d.dot(k.k2(d));
-  }
-  return total;
-}
-
 }  // namespace
 
 MissingAxialForces::MissingAxialForces(const Model& model, const Data& data) : n_(model.n_dofs) {
@@ -126,7 +100,6 @@ void MissingAxialForces::build(const Model& model, const Data& data,
       names_.push_back(group);
       counts_.push_back(0);
       forces_.push_back(0.0);
-      bending_.push_back(0.0);
     }
     ++counts_[g];
     const double l = b.ends.length;
@@ -137,14 +110,6 @@ void MissingAxialForces::build(const Model& model, const Data& data,
     e.free1 = model.bodies[b.ends.body1].free_index;
     e.free2 = model.bodies[b.ends.body2].free_index;
     if (e.free1 < 0 && e.free2 < 0) continue;
-    if (!direction) {
-      // d^T K_b d: the beam law's K2 on the bending coordinates alone.
-      Vec6 d = beam_deformation(b, f);
-      d(0) = 0.0;
-      d(3) = 0.0;
-      const StiffnessBlocks<double> k(b.ea, b.gj, b.eiy, b.eiz, l);
-      bending_[g] += d.dot(k.k2(d));
-    }
     e.beam = g;
     e.e1 = f.E1;
     e.t = f.t;
@@ -249,16 +214,6 @@ std::vector<double> MissingAxialForces::stiffness_energy(const Eigen::VectorXd& 
     change(e, v, &dxi, &dphi);
     local_forces(e, dxi, dphi, &f, &m);
     out[e.beam] -= f.dot(dxi) + m.dot(dphi);
-  }
-  return out;
-}
-
-std::vector<double> MissingAxialForces::deformation_energy() const {
-  std::vector<double> out(names_.size(), 0.0);
-  for (const Element& e : elements_) {
-    Vec3 f, m;
-    local_forces(e, e.offset, e.turn, &f, &m);
-    out[e.beam] -= f.dot(e.offset) + m.dot(e.turn);
   }
   return out;
 }
@@ -384,43 +339,6 @@ std::string modal_axial_force_warning(const MissingAxialForces& missing,
     worst.offer(ratio > 0.0 ? std::abs(std::sqrt(ratio) - 1.0) : kInf, i, energy);
   }
   return worst.worded("the frequency of mode", "would make mode %d unstable", missing);
-}
-
-void AxialForceWatch::observe(const Model& model, const Data& data, double t) {
-  if (model.beams.empty()) return;
-  const MissingAxialForces missing(model, data);
-  const double bending = sum(missing.bending_energy()) + rail_bending(model, data);
-  if (!(bending > 0.0) || !std::isfinite(bending)) return;
-  const std::vector<double> energy = missing.deformation_energy();
-  if (names_.empty()) {
-    names_ = missing.beam_names();
-    counts_ = missing.beam_elements();
-    missing_.assign(names_.size(), 0.0);
-    forces_.assign(names_.size(), 0.0);
-  }
-  bending_ += bending;
-  for (size_t g = 0; g < names_.size(); ++g) {
-    if (!std::isfinite(energy[g])) continue;
-    missing_[g] += energy[g];
-    const double force = missing.beam_forces()[g];
-    if (std::abs(force) > std::abs(forces_[g])) forces_[g] = force;
-  }
-  t_ = t;
-}
-
-std::string AxialForceWatch::warning() const {
-  if (!(bending_ > 0.0)) return "";
-  const double size = std::abs(sum(missing_)) / bending_;
-  const int beam = largest(missing_);
-  if (!(size > kAxialForceWarning) || beam < 0) return "";
-  char text[300];
-  std::snprintf(text, sizeof text,
-                "the axial forces of the beams change the bending stiffness of the motion by "
-                "about %.3g of it (its mean over the samples up to t = %.6g s; its side "
-                "deflections by about as much, its frequencies by half) beyond what the model "
-                "holds, ",
-                size, t_);
-  return text + advice(names_[beam], counts_[beam], forces_[beam], size);
 }
 
 }  // namespace beamrail

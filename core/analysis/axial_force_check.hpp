@@ -13,11 +13,7 @@
 //    below -1, K = -S), which a perfect column, with no offset to correct, shows only so;
 //  - a mode (M-normalized shape x, w^2): w'^2 = w^2 + x^T K_s x (Rayleigh);
 //  - a buckling factor (K0 x = lambda (-K1) x): the same quotient with the missing stiffness of
-//    the reference state and of the scaled loads per unit factor;
-//  - a transient: at each output sample, the quotient of the elements' own deformation, the
-//    missing stiffness's energy of each element's (v, t) over the bending energy the beam law
-//    gives them (AxialForceWatch): by how much the axial forces stiffen or soften the bending the
-//    motion has then.
+//    the reference state and of the scaled loads per unit factor.
 // Segments reduce each as 1/n^2.
 #pragma once
 
@@ -63,12 +59,6 @@ class MissingAxialForces {
   const std::vector<int>& beam_elements() const { return counts_; }
   // Per scene beam: the axial force of largest magnitude among its elements [N] (tension > 0).
   const std::vector<double>& beam_forces() const { return forces_; }
-  // Per scene beam, of the elements' own deformation at the state (each right end's offset and
-  // turn in its left end's frame, d): d^T K_b d, the bending part of the beam law's stiffness
-  // (its energy times 2; every element, with or without an axial force), and d^T K_s d, the
-  // missing stiffness's (0 for the constructor with a direction).
-  const std::vector<double>& bending_energy() const { return bending_; }
-  std::vector<double> deformation_energy() const;
 
  private:
   struct Element {
@@ -97,7 +87,6 @@ class MissingAxialForces {
   std::vector<std::string> names_;
   std::vector<int> counts_;
   std::vector<double> forces_;
-  std::vector<double> bending_;
 };
 
 // What the missing forces do to a static equilibrium; `solve` applies S^-1 (the factorized
@@ -133,29 +122,5 @@ std::string buckling_axial_force_warning(const MissingAxialForces& reference,
 std::string modal_axial_force_warning(const MissingAxialForces& missing,
                                       const std::vector<Eigen::VectorXd>& shapes,
                                       const std::vector<double>& eigenvalues);
-
-// Watches the samples of a transient: R = sum over samples of d^T K_s d over the sum of d^T K_b d,
-// both over the elements' own deformation (MissingAxialForces::deformation_energy,
-// bending_energy; K_b of the rails too: a carriage's rails hold its side motion, not the drive
-// rod that pulls it, whose bending stiffness is 1e-8 of theirs, studies/carriage_two_rails.json):
-// the relative change that the axial forces would make to the bending stiffness
-// of the motion, each sample weighted by its bending energy (its side deflections change by about
-// -R of them, its frequencies by about R/2). A mean, not the largest sample's: a step load rings
-// the axial modes, whose forces swing between none and twice the mean faster than the bending
-// follows (a column's largest sample gave twice the error of its sway).
-class AxialForceWatch {
- public:
-  void observe(const Model& model, const Data& data, double t);
-  // The warning for |R|, "" below kAxialForceWarning.
-  std::string warning() const;
-
- private:
-  double bending_ = 0.0;         // sum of d^T K_b d over the samples
-  std::vector<double> missing_;  // per scene beam, sum of d^T K_s d over the samples
-  std::vector<double> forces_;   // per scene beam, its axial force of largest magnitude [N]
-  std::vector<std::string> names_;
-  std::vector<int> counts_;
-  double t_ = 0.0;  // the last sample's time [s]
-};
 
 }  // namespace beamrail

@@ -7,7 +7,6 @@
 #include <exception>
 #include <stdexcept>
 
-#include "core/analysis/axial_force_check.hpp"
 #include "core/analysis/deformation_check.hpp"
 #include "core/analysis/integrators.hpp"
 #include "core/analysis/sundials_support.hpp"
@@ -161,7 +160,6 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   IntegratorOptions io = options.integrator;
   io.horizon = options.t_end;
   DeformationCheck deformation(model);
-  AxialForceWatch axial_forces;
   try {
     SundialsContext ctx;
     OdeContext context(model, data);
@@ -195,7 +193,6 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     const auto deliver = [&](double t) {
       const TransientSample s = sample_at(model, data, t, y.data());
       deformation.observe(model, data, t);
-      axial_forces.observe(model, data, t);
       if (observer) observer(s, data);
     };
     deliver(0.0);
@@ -268,7 +265,6 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
       result.warnings.push_back("rail \"" + model.rails[r].name + "\" reached its min_length");
   // Checked at the output samples: accepted states only, never Newton trial states.
   for (std::string& w : deformation.warnings(model, true)) result.warnings.push_back(std::move(w));
-  if (std::string w = axial_forces.warning(); !w.empty()) result.warnings.push_back(std::move(w));
   result.stats.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -125,7 +125,7 @@ class ModalExponential : public Integrator {
         have_n0_ = flag == kOk;
         if (have_n0_) {
           flag = reached;
-          quasi_.compute_rate(StepFunctions::c[StepFunctions::kStages - 1]);
+          quasi_.compute_rate();
         }
       } catch (const std::exception& e) {
         context_->callback_error = e.what();

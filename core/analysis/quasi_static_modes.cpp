@@ -73,14 +73,15 @@ void QuasiStaticModes::accepted(double h, double c, const Eigen::Ref<const Eigen
   y_begin_ = y_start_;
   y_stage_ = y_;
   last_step_ = h;
+  last_stage_ = c;
   rate_known_ = false;
   kinetic_ = std::max(kinetic_, work_n_.dot(*m0_ * work_n_));
   band_kinetic_ = std::max(band_kinetic_, nu.squaredNorm());
 }
 
-void QuasiStaticModes::compute_rate(double c) {
+void QuasiStaticModes::compute_rate() {
   if (!(last_step_ > 0.0)) return;
-  const double h = last_step_;
+  const double c = last_stage_, h = last_step_;
   y_rate_ = ((1.0 - c) / (c * h)) * y_begin_ - (1.0 / (c * (1.0 - c) * h)) * y_stage_ +
             ((2.0 - c) / ((1.0 - c) * h)) * y_;
   rate_known_ = true;

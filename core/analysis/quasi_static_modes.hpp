@@ -65,7 +65,7 @@ class QuasiStaticModes {
   // dy/dt at the accepted state, from y at the last step's start, at its last stage and at its
   // end (y, converged since): the derivative of the parabola through them, second order in h.
   // Unknown (rate_known() false) before a step.
-  void compute_rate(double c);
+  void compute_rate();
   bool rate_known() const { return rate_known_; }
   const Eigen::VectorXd& rate() const { return y_rate_; }
 
@@ -91,6 +91,7 @@ class QuasiStaticModes {
   // the start or a restart); the rate of y at the accepted state when rate_known_.
   Eigen::VectorXd y_begin_, y_stage_, y_rate_;
   double last_step_ = 0.0;
+  double last_stage_ = 0.5;  // where the last accepted step's last stage lay, c of c h
   bool rate_known_ = false;
   double kinetic_ = 0.0;          // the largest |dy/dt|^2_M0 so far
   double band_kinetic_ = 0.0;     // and |nu|^2

@@ -48,9 +48,11 @@ int largest_product_team();
 // side.
 void multiply_pair(const Eigen::MatrixXd& a, const double* x, double* y);
 
-// y = a x for x (a.cols() x 6) and y (a.rows() x 6), column-major: three pairs in one pass (a
-// trial step's new state and its two error estimates).
+// y = a x for x (a.cols() x 6) and y (a.rows() x 6), column-major: three pairs (a trial step's
+// new state and its two error estimates), in one pass over a where the CPU has AVX-512, as three
+// pair products else (three_pairs_in_one_pass).
 void multiply_three_pairs(const Eigen::MatrixXd& a, const double* x, double* y);
+bool three_pairs_in_one_pass();
 
 // y = a x for the vectors x (length a.cols()) and y (length a.rows()).
 void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y);

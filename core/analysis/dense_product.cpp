@@ -156,6 +156,51 @@ BEAMRAIL_CLONES void vector_kernel(long rows, long cols, const double* a, long l
     product_kernel<1, false>(rows, cols, a, lda, x, y, ldy);
 }
 
+// y_j = sum_i a_ij x_i for the columns [begin, end) of the rows x cols matrix a (a^T x): eight
+// columns at a time against one load of x, each sum in 4-double vectors (one AVX2 register) over
+// the rows, the last rows % 4 added after. Each column is summed alone, so the bits do not depend
+// on how the columns are shared out. Measured on an AVX2 machine (AMD EPYC) against Eigen's
+// a.transpose() * x (SSE2 as this library is compiled): n = 1,038 164 against 201 us, n = 240
+// 8.2 against 11.5 us, 6,000 x 95 88 against 111 us.
+BEAMRAIL_CLONES void transposed_kernel(long rows, long begin, long end, const double* a,
+                                       const double* x, double* y) {
+  typedef double Lanes __attribute__((vector_size(32)));
+  constexpr int kColumns = 8;
+  const long body = rows - rows % 4;
+  const auto finish = [&](const Lanes& sum, long j) {
+    double lanes[4];
+    std::memcpy(lanes, &sum, sizeof lanes);
+    double t = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+    for (long i = body; i < rows; ++i) t += a[j * rows + i] * x[i];
+    y[j] = t;
+  };
+  long j = begin;
+  for (; j + kColumns <= end; j += kColumns) {
+    Lanes s[kColumns];
+    for (int c = 0; c < kColumns; ++c) s[c] = Lanes{0.0, 0.0, 0.0, 0.0};
+    for (long i = 0; i < body; i += 4) {
+      Lanes v;
+      std::memcpy(&v, x + i, sizeof v);
+      for (int c = 0; c < kColumns; ++c) {
+        Lanes column;
+        std::memcpy(&column, a + (j + c) * rows + i, sizeof column);
+        s[c] += column * v;
+      }
+    }
+    for (int c = 0; c < kColumns; ++c) finish(s[c], j + c);
+  }
+  for (; j < end; ++j) {
+    Lanes s = {0.0, 0.0, 0.0, 0.0};
+    for (long i = 0; i < body; i += 4) {
+      Lanes v, column;
+      std::memcpy(&v, x + i, sizeof v);
+      std::memcpy(&column, a + j * rows + i, sizeof column);
+      s += column * v;
+    }
+    finish(s, j);
+  }
+}
+
 using Kernel = void (*)(long, long, const double*, long, const double*, double*, long);
 
 // The product in row blocks, one per thread, where the matrix is large enough for the threads
@@ -223,10 +268,9 @@ void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y) {
 
 void multiply_transposed(const Eigen::MatrixXd& a, const double* x, double* y) {
   const long rows = a.rows(), cols = a.cols();
-  const Eigen::Map<const Eigen::VectorXd> v(x, rows);
   const int threads = threads_for(rows, cols, cols);
   if (threads <= 1) {
-    Eigen::Map<Eigen::VectorXd>(y, cols).noalias() = a.transpose() * v;
+    transposed_kernel(rows, 0, cols, a.data(), x, y);
     return;
   }
 #ifdef _OPENMP
@@ -234,20 +278,10 @@ void multiply_transposed(const Eigen::MatrixXd& a, const double* x, double* y) {
   {
     const long n = omp_get_num_threads(), id = omp_get_thread_num();
     if (id == 0) count_team(n);
-    // Eigen's product takes the columns 8, 4, 2 and 1 at a time, and sums a column's last rows
-    // in another order in its one-column loop than in the others when vectorized for AVX (and
-    // a one-column block becomes a dot product): blocks that start at multiples of 8 columns,
-    // the last one at least 8 long, put every column in the loop it has on one thread, so the
-    // bits do not move.
-    const long block = ((cols + n - 1) / n + 7) / 8 * 8;
-    const auto bound = [&](long k) {
-      const long b = std::min(cols, k * block);
-      return cols - b < 8 ? cols : b;
-    };
-    const long begin = bound(id), end = id + 1 == n ? cols : bound(id + 1);
-    if (end > begin)
-      Eigen::Map<Eigen::VectorXd>(y + begin, end - begin).noalias() =
-          a.middleCols(begin, end - begin).transpose() * v;
+    const long block = ((cols + n - 1) / n + 7) / 8 * 8;  // whole groups of 8 columns
+    const long begin = std::min(cols, id * block);
+    const long end = id + 1 == n ? cols : std::min(cols, begin + block);
+    if (end > begin) transposed_kernel(rows, begin, end, a.data(), x, y);
   }
 #endif
 }

@@ -25,7 +25,8 @@
 // one (Phi^T (M0 a), M0 a 6 x 6 block per body: Phi is the one dense matrix stored, and a stored
 // M0 Phi beside it made the braced tower's every-mode run 26 % slower per step); hence a size
 // limit. The products use the threads of the caller's budget (ProductThreads,
-// core/analysis/dense_product.hpp): the tower's 1 s run took 17.7 s on 2 threads, 26.0 s on 1.
+// core/analysis/dense_product.hpp): the tower's 1 s run took 14.3 s on 2 threads, 15.8 s on 1
+// (AVX2 kernels; README "Why this machine ran the tower slower").
 // Accuracy degrades with the size of the motion: past kMaxRotation the run stops with a message
 // naming the body.
 //

@@ -35,63 +35,14 @@ int threads_for(long rows, long cols, long parts) {
   return 1;
 }
 
-// One pass over the columns of the rows x cols matrix a (8 at a time: y is loaded and stored once
-// per 8 columns) for `kVectors` right-hand sides (x: cols x kVectors, y: rows x kVectors, both
-// column-major). Plain loops over i that the compiler vectorizes for each target below.
-// kSquare: rows == cols, one variable for both (the compiler then keeps the square case's code as
-// fast as before the kernel took rectangles: the braced tower's every-mode run was 8 % slower).
-template <int kVectors, bool kSquare>
-[[gnu::always_inline]] inline void product_kernel(long rows, long cols_given,
-                                                  const double* __restrict a, long lda_given,
-                                                  const double* __restrict x, double* __restrict y,
-                                                  long ldy_given) {
-  const long cols = kSquare ? rows : cols_given;
-  const long lda = kSquare ? rows : lda_given;
-  const long ldy = kSquare ? rows : ldy_given;
-  constexpr int kBlock = 8;
-  if (rows < kBlock && cols < kBlock) {
-    // A few modes (a small scene relinearized often): the blocked loops' set-up would dominate.
-    for (int v = 0; v < kVectors; ++v)
-      for (long i = 0; i < rows; ++i) {
-        double s = 0.0;
-        for (long k = 0; k < cols; ++k) s += a[k * lda + i] * x[v * cols + k];
-        y[v * ldy + i] = s;
-      }
-    return;
-  }
-  for (int v = 0; v < kVectors; ++v)
-    for (long i = 0; i < rows; ++i) y[v * ldy + i] = 0.0;
-  long k = 0;
-  for (; k + kBlock <= cols; k += kBlock) {
-    const double* col = a + k * lda;
-    double p[kVectors][kBlock];
-    for (int v = 0; v < kVectors; ++v)
-      for (int j = 0; j < kBlock; ++j) p[v][j] = x[v * cols + k + j];
-    for (long i = 0; i < rows; ++i) {
-      double s[kVectors];
-      for (int v = 0; v < kVectors; ++v) s[v] = y[v * ldy + i];
-      for (int j = 0; j < kBlock; ++j) {
-        const double c = col[j * lda + i];
-        for (int v = 0; v < kVectors; ++v) s[v] += p[v][j] * c;
-      }
-      for (int v = 0; v < kVectors; ++v) y[v * ldy + i] = s[v];
-    }
-  }
-  for (; k < cols; ++k) {
-    const double* col = a + k * lda;
-    for (int v = 0; v < kVectors; ++v) {
-      const double p = x[v * cols + k];
-      for (long i = 0; i < rows; ++i) y[v * ldy + i] += p * col[i];
-    }
-  }
-}
-
-// y = a x for kVectors right-hand sides, written with the compiler's vector types (8 doubles: one
-// AVX-512 register, two AVX2 ones, four SSE2 ones) where product_kernel's plain loops do not
-// vectorize for six: per 8 rows, the kVectors partial sums stay in registers over kBlock matrix
-// columns. Measured at n = 1038 on the reference machine: three pairs in one pass 302 us, three
-// passes of product_kernel 502 us.
-// kLanes: the doubles per partial sum (8, or 4: one AVX2 register).
+// y = a x for kVectors right-hand sides (x: cols x kVectors, y: rows x kVectors, column-major),
+// written with the compiler's vector types: per kLanes rows, the kVectors partial sums stay in
+// registers over kBlock = 8 matrix columns (y is loaded and stored once per 8 columns). kLanes:
+// 8 doubles (one AVX-512 register, two AVX2 ones) or 4 (one AVX2 register). Measured at n = 1038
+// on the reference machine (AVX-512): three pairs in one pass (8 lanes) 302 us, three passes of
+// plain loops that the compiler vectorized 502 us; on an AVX2 machine (AMD EPYC) a pair with 4
+// lanes 230 us, with those plain loops 350 us, one vector 179 against 183 us (and 78 against 83
+// us at 6,000 x 95, 6.3 against 8.5 us at n = 240).
 template <int kVectors, int kLanes = 8>
 [[gnu::always_inline]] inline void wide_kernel(long rows, long cols, const double* __restrict a,
                                                long lda, const double* __restrict x,
@@ -150,10 +101,7 @@ BEAMRAIL_CLONES void six_kernel(long rows, long cols, const double* a, long lda,
 
 BEAMRAIL_CLONES void vector_kernel(long rows, long cols, const double* a, long lda, const double* x,
                                    double* y, long ldy) {
-  if (rows == cols && lda == rows && ldy == rows)
-    product_kernel<1, true>(rows, cols, a, lda, x, y, ldy);
-  else
-    product_kernel<1, false>(rows, cols, a, lda, x, y, ldy);
+  wide_kernel<1, 4>(rows, cols, a, lda, x, y, ldy);
 }
 
 // y_j = sum_i a_ij x_i for the columns [begin, end) of the rows x cols matrix a (a^T x): eight

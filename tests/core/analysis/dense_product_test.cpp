@@ -52,7 +52,7 @@ double worst_difference(const Eigen::MatrixXd& a) {
 }
 
 TEST(DenseProduct, MatchesEigenAtEverySizeAroundTheBlocking) {
-  // The kernels work on 8 columns (and the six-vector one on 8 rows) at a time and leave
+  // The kernels work on 8 columns and 4 or 8 rows at a time and leave
   // remainders; sizes around multiples of 8 and the modal integrator's sizes (6 per body).
   double worst = 0.0;
   for (int n : {1, 2, 5, 7, 8, 9, 15, 16, 17, 60, 240, 601})

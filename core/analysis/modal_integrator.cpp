@@ -541,7 +541,7 @@ class ModalExponential : public Integrator {
           // The distance to the embedded third-order solution, h b5 (N5 - N3), and to the
           // embedded second-order one from stages 1 and 2 against rtol^(3/4) (both then ask for
           // steps ~ rtol^(1/4)); the new state and both distances go to physical states in one
-          // pass over Phi.
+          // call (multiply_three_pairs: one pass over Phi with AVX-512, three without).
           trial_.resize(m_, 6);
           trial_.leftCols<2>() = next;
           Block& difference = difference_;

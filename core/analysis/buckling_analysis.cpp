@@ -14,6 +14,7 @@
 #include "core/analysis/axial_force_check.hpp"
 #include "core/analysis/buckling_path.hpp"
 #include "core/analysis/deadline.hpp"
+#include "core/analysis/dense_eigen.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
 #include "core/model/rotation.hpp"
@@ -121,10 +122,8 @@ Eigen::VectorXd normalized_shape(Eigen::VectorXd x, double length) {
 void solve_dense(const SparseMatrix& a, const SparseMatrix& k0, Eigen::VectorXd& mu,
                  Eigen::MatrixXd& vectors) {
   const Eigen::MatrixXd ad(a), bd(k0);
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(ad, bd);
-  if (eig.info() != Eigen::Success) throw std::runtime_error("the dense eigensolver failed");
-  mu = eig.eigenvalues();
-  vectors = eig.eigenvectors();
+  if (!generalized_symmetric_eigen(ad, bd, mu, vectors))
+    throw std::runtime_error("the dense eigensolver failed");
 }
 
 }  // namespace

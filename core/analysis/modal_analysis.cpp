@@ -18,6 +18,7 @@
 
 #include "core/analysis/axial_force_check.hpp"
 #include "core/analysis/deadline.hpp"
+#include "core/analysis/dense_eigen.hpp"
 #include "core/analysis/element_deformation.hpp"
 #include "core/analysis/sparse_structure.hpp"
 #include "core/model/forces.hpp"
@@ -323,10 +324,7 @@ void participations(const Model& model, const Data& data, const SparseMatrix& m,
 
 bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& md,
                               Eigen::VectorXd& values, Eigen::MatrixXd& vectors, double shift) {
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(kd, md);
-  if (eig.info() != Eigen::Success) return false;
-  values = eig.eigenvalues();  // ascending
-  vectors = eig.eigenvectors();
+  if (!generalized_symmetric_eigen(kd, md, values, vectors)) return false;  // ascending
   const Eigen::Index n = values.size();
   if (n < 2) return true;
   double mu = shift;
@@ -352,11 +350,11 @@ bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& 
   }
   if (!b.allFinite()) return true;
   b = 0.5 * (b + b.transpose()).eval();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> inv(b);
-  if (inv.info() != Eigen::Success) return true;
+  Eigen::VectorXd nu;
+  Eigen::MatrixXd inverse_vectors;
+  if (!symmetric_eigen(b, nu, inverse_vectors)) return true;
   // nu = 1/(w^2 + mu): the largest |nu| are the eigenvalues nearest -mu. Order them by w^2.
-  const Eigen::VectorXd nu = inv.eigenvalues();
-  const Eigen::MatrixXd x = mf.matrixU().solve(inv.eigenvectors());
+  const Eigen::MatrixXd x = mf.matrixU().solve(inverse_vectors);
   std::vector<Eigen::Index> order(n);
   for (Eigen::Index i = 0; i < n; ++i) order[i] = i;
   std::sort(order.begin(), order.end(),

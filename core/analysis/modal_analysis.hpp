@@ -145,8 +145,8 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
 // ~eps lambda_max absolute; when shift >= 0 is given and K + shift M can be factored, the lower
 // part of the spectrum comes from the inverse problem (K + shift M)^-1 M, accurate to ~eps
 // (lambda + shift) instead. Without a shift (negative), the inverse problem is used only when K
-// is positive definite and the spectrum spans more than 6 decades. False when Eigen's solver
-// fails.
+// is positive definite and the spectrum spans more than 6 decades. False when the dense
+// solver fails (core/analysis/dense_eigen.hpp: LAPACK from 100 rows, Eigen below).
 bool solve_dense_eigenproblem(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m,
                               Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                               double shift = -1.0);

@@ -1,0 +1,49 @@
+// The dense symmetric generalized eigenproblem K x = w^2 M x of the reference cantilever in N
+// segments (6 N dof) by Eigen's QL iteration and by LAPACK's dsygvd
+// (core/analysis/dense_eigen.hpp): the figures behind kLapackEigenFrom. Arguments: segments, driver
+// (0 Eigen, 1 LAPACK).
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "core/analysis/dense_eigen.hpp"
+#include "core/model/data.hpp"
+#include "core/model/forces.hpp"
+#include "core/model/generalized.hpp"
+#include "tests/benchmarks/reference_problem.hpp"
+
+namespace beamrail {
+namespace {
+
+void Generalized(benchmark::State& state) {
+  const Model model = bench::reference_model(static_cast<int>(state.range(0)));
+  Data data(model);
+  std::vector<double> y(static_cast<size_t>(model.n_states));
+  initial_state(model, y.data());
+  set_state(model, data, y.data());
+  compute_wrenches(model, data, 0.0);
+  compute_tangent(model, data, 0.0, false);
+  const Eigen::MatrixXd s = -Eigen::MatrixXd(stiffness_matrix(model, data));
+  const Eigen::MatrixXd k = 0.5 * (s + s.transpose());
+  const Eigen::MatrixXd m(mass_matrix(model, data));
+  const DenseEigenDriver driver =
+      state.range(1) ? DenseEigenDriver::kLapack : DenseEigenDriver::kEigen;
+  Eigen::VectorXd values;
+  Eigen::MatrixXd vectors;
+  for (auto _ : state) {
+    if (!generalized_symmetric_eigen(k, m, values, vectors, driver))
+      state.SkipWithError("the eigensolver failed");
+    benchmark::DoNotOptimize(vectors.data());
+  }
+  state.counters["dof"] = static_cast<double>(k.rows());
+}
+
+BENCHMARK(Generalized)
+    ->ArgsProduct({{5, 10, 17, 25, 40, 100, 173}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace beamrail
+
+BENCHMARK_MAIN();

@@ -77,8 +77,10 @@ bool lapack_generalized(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, Eige
 
 bool symmetric_eigen(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                      DenseEigenDriver driver) {
-  if (use_lapack(a.rows(), driver) && a.allFinite() && lapack_symmetric(a, values, vectors))
-    return true;
+  if (use_lapack(a.rows(), driver)) {
+    if (a.allFinite() && lapack_symmetric(a, values, vectors)) return true;
+    if (driver == DenseEigenDriver::kLapack) return false;
+  }
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
   if (eig.info() != Eigen::Success) return false;
   values = eig.eigenvalues();
@@ -89,9 +91,10 @@ bool symmetric_eigen(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::M
 bool generalized_symmetric_eigen(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                                  Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                                  DenseEigenDriver driver) {
-  if (use_lapack(a.rows(), driver) && a.allFinite() && b.allFinite() &&
-      lapack_generalized(a, b, values, vectors))
-    return true;
+  if (use_lapack(a.rows(), driver)) {
+    if (a.allFinite() && b.allFinite() && lapack_generalized(a, b, values, vectors)) return true;
+    if (driver == DenseEigenDriver::kLapack) return false;
+  }
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, b);
   if (eig.info() != Eigen::Success) return false;
   values = eig.eigenvalues();

@@ -8,8 +8,9 @@
 // 6.4 ms, 102 dof 1.39 against 0.89 ms, 60 dof 0.32 against 0.53 ms.
 // The calls to LAPACK are serialized by a lock: the serial OpenBLAS is not documented as safe
 // for concurrent calls, and a batch evaluates designs on several threads. When LAPACK reports
-// a failure (B not positive definite, no convergence) Eigen's solver is tried instead, as
-// before these drivers, so that its callers keep their own checks.
+// a failure (B not positive definite, no convergence) the automatic choice tries Eigen's solver
+// instead, as before these drivers, so that its callers keep their own checks; kLapack alone
+// then returns false.
 #pragma once
 
 #include <Eigen/Dense>
@@ -20,7 +21,8 @@ enum class DenseEigenDriver { kAutomatic, kEigen, kLapack };
 
 inline constexpr Eigen::Index kLapackEigenFrom = 100;
 
-// False when the solver failed (non-finite input, no convergence).
+// False when the solver failed (non-finite input, no convergence; kLapack: also B not positive
+// definite).
 bool symmetric_eigen(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                      DenseEigenDriver driver = DenseEigenDriver::kAutomatic);
 

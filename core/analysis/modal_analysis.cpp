@@ -320,6 +320,40 @@ void participations(const Model& model, const Data& data, const SparseMatrix& m,
   for (Mode& mode : result.modes) mode.participation = (mode.shape.transpose() * mr).transpose();
 }
 
+// The inverse problem M x = nu (K + mu M) x, a = K + mu M: nu = 1/(w^2 + mu) and M-normalized
+// x. False when it could not be solved.
+bool solve_inverse_problem(const Eigen::MatrixXd& a, const Eigen::MatrixXd& md, Eigen::VectorXd& nu,
+                           Eigen::MatrixXd& x) {
+  // a positive definite, from LAPACK's rows on: the pencil (M, a) as it stands, its vectors
+  // a-normalized (x^T a x = 1, so x^T M x = nu): one call instead of the two factorizations,
+  // the solves and the eigensolver below.
+  if (a.rows() >= kLapackEigenFrom &&
+      generalized_symmetric_eigen(md, a, nu, x, DenseEigenDriver::kLapack) &&
+      (nu.array() > 0.0).all()) {
+    for (Eigen::Index j = 0; j < nu.size(); ++j) x.col(j) /= std::sqrt(nu(j));
+    return true;
+  }
+  const Eigen::LLT<Eigen::MatrixXd> mf(md);
+  if (mf.info() != Eigen::Success) return false;
+  // With M = L L^T: B = L^T a^-1 L has eigenvalues 1/(w^2 + mu), eigenvectors L^T x. Cholesky
+  // where a is positive definite (the usual case), else a pivoted LDL^T.
+  const Eigen::MatrixXd l = mf.matrixL();
+  Eigen::MatrixXd b;
+  if (const Eigen::LLT<Eigen::MatrixXd> llt(a); llt.info() == Eigen::Success) {
+    b = l.transpose() * llt.solve(l);
+  } else {
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+    if (ldlt.info() != Eigen::Success) return false;
+    b = l.transpose() * ldlt.solve(l);
+  }
+  if (!b.allFinite()) return false;
+  b = 0.5 * (b + b.transpose()).eval();
+  Eigen::MatrixXd y;
+  if (!symmetric_eigen(b, nu, y)) return false;
+  x = mf.matrixU().solve(y);
+  return true;
+}
+
 }  // namespace
 
 bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& md,
@@ -334,27 +368,10 @@ bool solve_dense_eigenproblem(const Eigen::MatrixXd& kd, const Eigen::MatrixXd& 
     if (!(values(0) > 1e-12 * top) || values(n - 1) < 1e6 * values(0)) return true;
     mu = 0.0;
   }
-  const Eigen::MatrixXd a = kd + mu * md;
-  const Eigen::LLT<Eigen::MatrixXd> mf(md);
-  if (mf.info() != Eigen::Success) return true;
-  // With M = L L^T: B = L^T (K + mu M)^-1 L has eigenvalues 1/(w^2 + mu), eigenvectors L^T x.
-  // Cholesky where K + mu M is positive definite (the usual case), else a pivoted LDL^T.
-  const Eigen::MatrixXd l = mf.matrixL();
-  Eigen::MatrixXd b;
-  if (const Eigen::LLT<Eigen::MatrixXd> llt(a); llt.info() == Eigen::Success) {
-    b = l.transpose() * llt.solve(l);
-  } else {
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
-    if (ldlt.info() != Eigen::Success) return true;
-    b = l.transpose() * ldlt.solve(l);
-  }
-  if (!b.allFinite()) return true;
-  b = 0.5 * (b + b.transpose()).eval();
   Eigen::VectorXd nu;
-  Eigen::MatrixXd inverse_vectors;
-  if (!symmetric_eigen(b, nu, inverse_vectors)) return true;
+  Eigen::MatrixXd x;
+  if (!solve_inverse_problem(kd + mu * md, md, nu, x)) return true;
   // nu = 1/(w^2 + mu): the largest |nu| are the eigenvalues nearest -mu. Order them by w^2.
-  const Eigen::MatrixXd x = mf.matrixU().solve(inverse_vectors);
   std::vector<Eigen::Index> order(n);
   for (Eigen::Index i = 0; i < n; ++i) order[i] = i;
   std::sort(order.begin(), order.end(),

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/analysis/dense_eigen.hpp"
+#include "core/analysis/modal_analysis.hpp"
 #include "core/model/data.hpp"
 #include "core/model/forces.hpp"
 #include "core/model/generalized.hpp"
@@ -15,8 +16,12 @@
 namespace beamrail {
 namespace {
 
-void Generalized(benchmark::State& state) {
-  const Model model = bench::reference_model(static_cast<int>(state.range(0)));
+struct Pencil {
+  Eigen::MatrixXd k, m;
+};
+
+Pencil pencil(int segments) {
+  const Model model = bench::reference_model(segments);
   Data data(model);
   std::vector<double> y(static_cast<size_t>(model.n_states));
   initial_state(model, y.data());
@@ -24,8 +29,11 @@ void Generalized(benchmark::State& state) {
   compute_wrenches(model, data, 0.0);
   compute_tangent(model, data, 0.0, false);
   const Eigen::MatrixXd s = -Eigen::MatrixXd(stiffness_matrix(model, data));
-  const Eigen::MatrixXd k = 0.5 * (s + s.transpose());
-  const Eigen::MatrixXd m(mass_matrix(model, data));
+  return {0.5 * (s + s.transpose()), Eigen::MatrixXd(mass_matrix(model, data))};
+}
+
+void Generalized(benchmark::State& state) {
+  const auto [k, m] = pencil(static_cast<int>(state.range(0)));
   const DenseEigenDriver driver =
       state.range(1) ? DenseEigenDriver::kLapack : DenseEigenDriver::kEigen;
   Eigen::VectorXd values;
@@ -38,6 +46,21 @@ void Generalized(benchmark::State& state) {
   state.counters["dof"] = static_cast<double>(k.rows());
 }
 
+// solve_dense_eigenproblem (core/analysis/modal_analysis.hpp): the direct problem and, the
+// cantilever's spectrum spanning more than 6 decades, the inverse one for its lower half.
+void DirectAndInverse(benchmark::State& state) {
+  const auto [k, m] = pencil(static_cast<int>(state.range(0)));
+  Eigen::VectorXd values;
+  Eigen::MatrixXd vectors;
+  for (auto _ : state) {
+    if (!solve_dense_eigenproblem(k, m, values, vectors))
+      state.SkipWithError("the eigensolver failed");
+    benchmark::DoNotOptimize(vectors.data());
+  }
+  state.counters["dof"] = static_cast<double>(k.rows());
+}
+
+BENCHMARK(DirectAndInverse)->Arg(40)->Arg(173)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Generalized)
     ->ArgsProduct({{5, 10, 17, 25, 40, 100, 173}, {0, 1}})
     ->Unit(benchmark::kMillisecond)

@@ -35,7 +35,7 @@
 
 namespace beamrail {
 
-// EigenSolverKind::kAuto's choice for the buckling analysis: the dense solver (Eigen, one
+// EigenSolverKind::kAuto's choice for the buckling analysis: the dense solver (dense_eigen.hpp, one
 // generalized eigensolution of -K1 x = mu K0 x) below 3 wanted + 24 degrees of freedom, Lanczos in
 // Cholesky mode (Spectra, with K0's factors) from there. MEASURED
 inline bool buckling_dense_is_faster(Eigen::Index dofs, Eigen::Index wanted) {

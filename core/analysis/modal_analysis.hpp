@@ -39,11 +39,11 @@ enum class EigenSolverKind { kAuto, kDense, kShiftInvert };
 
 class SparseStructureCache;
 
-// EigenSolverKind::kAuto's choice for the modal analysis: the dense solver (Eigen, every eigenpair)
-// below `pairs` + 12 degrees of freedom, shift-invert Lanczos (Spectra) from there, `pairs` the
-// eigenpairs Lanczos computes: the modes wanted, plus 12 for rigid modes unless every free body is
-// held by beams. (Lanczos also needs 2 pairs degrees of freedom; below, solve_modal solves densely
-// whatever was asked.) MEASURED
+// EigenSolverKind::kAuto's choice for the modal analysis: the dense solver (every eigenpair;
+// dense_eigen.hpp) below `pairs` + 12 degrees of freedom, shift-invert Lanczos (Spectra) from
+// there, `pairs` the eigenpairs Lanczos computes: the modes wanted, plus 12 for rigid modes unless
+// every free body is held by beams. (Lanczos also needs 2 pairs degrees of freedom; below,
+// solve_modal solves densely whatever was asked.) MEASURED
 inline bool modal_dense_is_faster(Eigen::Index dofs, Eigen::Index pairs) {
   return dofs < pairs + 12;
 }

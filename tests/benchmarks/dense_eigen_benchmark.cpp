@@ -4,36 +4,17 @@
 // (0 Eigen, 1 LAPACK).
 #include <benchmark/benchmark.h>
 
-#include <vector>
-
 #include "core/analysis/dense_eigen.hpp"
 #include "core/analysis/modal_analysis.hpp"
-#include "core/model/data.hpp"
-#include "core/model/forces.hpp"
-#include "core/model/generalized.hpp"
 #include "tests/benchmarks/reference_problem.hpp"
+#include "tests/support/pencil.hpp"
 
 namespace beamrail {
 namespace {
 
-struct Pencil {
-  Eigen::MatrixXd k, m;
-};
-
-Pencil pencil(int segments) {
-  const Model model = bench::reference_model(segments);
-  Data data(model);
-  std::vector<double> y(static_cast<size_t>(model.n_states));
-  initial_state(model, y.data());
-  set_state(model, data, y.data());
-  compute_wrenches(model, data, 0.0);
-  compute_tangent(model, data, 0.0, false);
-  const Eigen::MatrixXd s = -Eigen::MatrixXd(stiffness_matrix(model, data));
-  return {0.5 * (s + s.transpose()), Eigen::MatrixXd(mass_matrix(model, data))};
-}
-
 void Generalized(benchmark::State& state) {
-  const auto [k, m] = pencil(static_cast<int>(state.range(0)));
+  const auto [k, m] =
+      testing::pencil_at_rest(bench::reference_model(static_cast<int>(state.range(0))));
   const DenseEigenDriver driver =
       state.range(1) ? DenseEigenDriver::kLapack : DenseEigenDriver::kEigen;
   Eigen::VectorXd values;
@@ -49,7 +30,8 @@ void Generalized(benchmark::State& state) {
 // solve_dense_eigenproblem (core/analysis/modal_analysis.hpp): the direct problem and, the
 // cantilever's spectrum spanning more than 6 decades, the inverse one for its lower half.
 void DirectAndInverse(benchmark::State& state) {
-  const auto [k, m] = pencil(static_cast<int>(state.range(0)));
+  const auto [k, m] =
+      testing::pencil_at_rest(bench::reference_model(static_cast<int>(state.range(0))));
   Eigen::VectorXd values;
   Eigen::MatrixXd vectors;
   for (auto _ : state) {

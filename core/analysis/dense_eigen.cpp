@@ -24,7 +24,11 @@ std::mutex& lapack_lock() {
   return lock;
 }
 
+// LAPACK's sizes are ints: dsygvd's workspace, 1 + 6 n + 2 n^2, passes INT_MAX from n = 32,768.
+constexpr Eigen::Index kLapackEigenBelow = 32768;
+
 bool use_lapack(Eigen::Index n, DenseEigenDriver driver) {
+  if (n >= kLapackEigenBelow) return false;
   if (driver == DenseEigenDriver::kAutomatic) return n >= kLapackEigenFrom;
   return driver == DenseEigenDriver::kLapack;
 }

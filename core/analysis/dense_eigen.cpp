@@ -24,13 +24,9 @@ std::mutex& lapack_lock() {
   return lock;
 }
 
-// LAPACK's sizes are ints: dsygvd's workspace, 1 + 6 n + 2 n^2, passes INT_MAX from n = 32,768.
-constexpr Eigen::Index kLapackEigenBelow = 32768;
-
-bool use_lapack(Eigen::Index n, DenseEigenDriver driver) {
-  if (n >= kLapackEigenBelow) return false;
-  if (driver == DenseEigenDriver::kAutomatic) return n >= kLapackEigenFrom;
-  return driver == DenseEigenDriver::kLapack;
+bool try_lapack(Eigen::Index n, DenseEigenDriver driver) {
+  return driver == DenseEigenDriver::kLapack ||
+         (driver == DenseEigenDriver::kAutomatic && lapack_eigen_automatic(n));
 }
 
 // One LAPACK driver call: a workspace query, then the call. `call(work, lwork, iwork, liwork)`
@@ -79,10 +75,15 @@ bool lapack_generalized(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, Eige
 
 }  // namespace
 
+bool lapack_eigen_automatic(Eigen::Index rows) {
+  return rows >= kLapackEigenFrom && rows < kLapackEigenBelow;
+}
+
 bool symmetric_eigen(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                      DenseEigenDriver driver) {
-  if (use_lapack(a.rows(), driver)) {
-    if (a.allFinite() && lapack_symmetric(a, values, vectors)) return true;
+  if (try_lapack(a.rows(), driver)) {
+    if (a.rows() < kLapackEigenBelow && a.allFinite() && lapack_symmetric(a, values, vectors))
+      return true;
     if (driver == DenseEigenDriver::kLapack) return false;
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
@@ -95,8 +96,10 @@ bool symmetric_eigen(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::M
 bool generalized_symmetric_eigen(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
                                  Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                                  DenseEigenDriver driver) {
-  if (use_lapack(a.rows(), driver)) {
-    if (a.allFinite() && b.allFinite() && lapack_generalized(a, b, values, vectors)) return true;
+  if (try_lapack(a.rows(), driver)) {
+    if (a.rows() < kLapackEigenBelow && a.allFinite() && b.allFinite() &&
+        lapack_generalized(a, b, values, vectors))
+      return true;
     if (driver == DenseEigenDriver::kLapack) return false;
   }
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, b);

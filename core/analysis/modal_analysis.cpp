@@ -324,10 +324,10 @@ void participations(const Model& model, const Data& data, const SparseMatrix& m,
 // x. False when it could not be solved.
 bool solve_inverse_problem(const Eigen::MatrixXd& a, const Eigen::MatrixXd& md, Eigen::VectorXd& nu,
                            Eigen::MatrixXd& x) {
-  // a positive definite, from LAPACK's rows on: the pencil (M, a) as it stands, its vectors
-  // a-normalized (x^T a x = 1, so x^T M x = nu): one call instead of the two factorizations,
-  // the solves and the eigensolver below.
-  if (a.rows() >= kLapackEigenFrom &&
+  // a positive definite, where the automatic choice is LAPACK (lapack_eigen_automatic): the
+  // pencil (M, a) as it stands, its vectors a-normalized (x^T a x = 1, so x^T M x = nu): one
+  // call instead of the two factorizations, the solves and the eigensolver below.
+  if (lapack_eigen_automatic(a.rows()) &&
       generalized_symmetric_eigen(md, a, nu, x, DenseEigenDriver::kLapack) &&
       (nu.array() > 0.0).all()) {
     for (Eigen::Index j = 0; j < nu.size(); ++j) x.col(j) /= std::sqrt(nu(j));

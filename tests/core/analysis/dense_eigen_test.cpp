@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <thread>
 #include <vector>
@@ -244,6 +245,26 @@ TEST(DenseEigen, APencilLapackRefusesGoesToEigen) {
   Eigen::MatrixXd vectors;
   EXPECT_FALSE(symmetric_eigen(k, values, vectors, DenseEigenDriver::kLapack));
   EXPECT_FALSE(generalized_symmetric_eigen(k, m, values, vectors, DenseEigenDriver::kLapack));
+}
+
+TEST(DenseEigen, LapacksIntSizesBoundTheChoice) {
+  // The automatic choice takes LAPACK from kLapackEigenFrom rows up to LAPACK's int limit, where
+  // dsygvd's workspace 1 + 6 n + 2 n^2 first passes INT_MAX.
+  const auto workspace = [](long long n) { return 1 + 6 * n + 2 * n * n; };
+  EXPECT_LE(workspace(kLapackEigenBelow - 1), std::numeric_limits<int>::max());
+  EXPECT_GT(workspace(kLapackEigenBelow), std::numeric_limits<int>::max());
+  EXPECT_FALSE(lapack_eigen_automatic(kLapackEigenFrom - 1));
+  EXPECT_TRUE(lapack_eigen_automatic(kLapackEigenFrom));
+  EXPECT_TRUE(lapack_eigen_automatic(kLapackEigenBelow - 1));
+  EXPECT_FALSE(lapack_eigen_automatic(kLapackEigenBelow));
+  // Asked for LAPACK alone at the limit, false before the data is looked at (so without the 8 GiB
+  // of a square matrix: these have no columns); not Eigen's answer in LAPACK's place, which the
+  // inverse problem's LAPACK-only route (modal_analysis.cpp) relies on.
+  const Eigen::MatrixXd huge(kLapackEigenBelow, 0);
+  Eigen::VectorXd values;
+  Eigen::MatrixXd vectors;
+  EXPECT_FALSE(symmetric_eigen(huge, values, vectors, DenseEigenDriver::kLapack));
+  EXPECT_FALSE(generalized_symmetric_eigen(huge, huge, values, vectors, DenseEigenDriver::kLapack));
 }
 
 }  // namespace

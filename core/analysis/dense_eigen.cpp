@@ -45,6 +45,7 @@ bool run_with_workspace(Call call) {
 }
 
 bool lapack_symmetric(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::MatrixXd& vectors) {
+  if (a.rows() >= kLapackEigenBelow) return false;  // its sizes are ints
   const int n = static_cast<int>(a.rows());
   vectors = a;
   values.resize(n);
@@ -59,6 +60,7 @@ bool lapack_symmetric(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::
 
 bool lapack_generalized(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, Eigen::VectorXd& values,
                         Eigen::MatrixXd& vectors) {
+  if (a.rows() >= kLapackEigenBelow) return false;  // its sizes are ints
   const int n = static_cast<int>(a.rows());
   const int itype = 1;  // A x = lambda B x
   vectors = a;
@@ -82,8 +84,7 @@ bool lapack_eigen_automatic(Eigen::Index rows) {
 bool symmetric_eigen(const Eigen::MatrixXd& a, Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                      DenseEigenDriver driver) {
   if (try_lapack(a.rows(), driver)) {
-    if (a.rows() < kLapackEigenBelow && a.allFinite() && lapack_symmetric(a, values, vectors))
-      return true;
+    if (a.allFinite() && lapack_symmetric(a, values, vectors)) return true;
     if (driver == DenseEigenDriver::kLapack) return false;
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
@@ -97,9 +98,7 @@ bool generalized_symmetric_eigen(const Eigen::MatrixXd& a, const Eigen::MatrixXd
                                  Eigen::VectorXd& values, Eigen::MatrixXd& vectors,
                                  DenseEigenDriver driver) {
   if (try_lapack(a.rows(), driver)) {
-    if (a.rows() < kLapackEigenBelow && a.allFinite() && b.allFinite() &&
-        lapack_generalized(a, b, values, vectors))
-      return true;
+    if (a.allFinite() && b.allFinite() && lapack_generalized(a, b, values, vectors)) return true;
     if (driver == DenseEigenDriver::kLapack) return false;
   }
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(a, b);

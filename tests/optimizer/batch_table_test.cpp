@@ -133,9 +133,10 @@ TEST(WriteRows, PiecesEndAtRowEndsWithinOnePageOfTheFile) {
     ASSERT_FALSE(piece.empty());
     EXPECT_EQ(piece.back(), '\n') << "a piece at " << at << " ends within a row";
     // Within a page, or one row that does not fit in the rest of its page.
-    if (at / 4096 != (at + static_cast<off_t>(piece.size()) - 1) / 4096)
+    if (at / 4096 != (at + static_cast<off_t>(piece.size()) - 1) / 4096) {
       EXPECT_EQ(piece.find('\n'), piece.size() - 1)
           << "a piece at " << at << " of " << piece.size() << " bytes crosses a page";
+    }
     at += static_cast<off_t>(piece.size());
     joined += piece;
   }

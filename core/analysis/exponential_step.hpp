@@ -37,13 +37,14 @@ inline void apply_add(const ModeFunction& f, const Eigen::ArrayXd& lambda, const
 //   Z_i = E(c_i h) z + h sum_j a_ij N_j,   z+ = E(h) z + h sum_j b_j N_j.
 // Why five stages (measured 2026-11-27, README "The tower over rtol and atol"): the four-stage
 // methods of Krogstad and of Strehmel and Weiner (c = 0, 1/2, 1/2, 1; stiff order 3) save one
-// evaluation and two products per step, and ran the README's braced tower at rtol 1e-6 in 6.75
-// against 8.10 s with the same steps (3,972) and errors (rotations 5.7e-6 against 5.5e-6). But no
-// third-order solution from their stages differs from theirs, so only the second-order estimate
-// controlled the step, and on rotating scenes the errors grew: the tumbling pair 3.8 .. 6.6 rtol
-// in its centres (this method 0.08 .. 0.39; with only its second-order estimate 0.11 .. 3.4),
-// the fast spin of transient_auto_test.cpp 36 rtol, the bob hinged to a cantilever
-// (joint_transient_test.cpp) 36 rtol at rtol 1e-7, the tumbling pair's energy over 10 s 955 rtol.
+// evaluation and two products per step; Krogstad's ran the README's braced tower at rtol 1e-6,
+// atol 1e-9 in 6.75 against 8.10 s with the same steps (3,972 against 3,970) and errors
+// (rotations 5.7e-6 against 5.5e-6). But their stages give no embedded third-order solution
+// other than the method's own, so only the second-order estimate controlled the step, and on
+// rotating scenes the errors of both grew: the tumbling pair 3.8 .. 6.6 rtol in its centres
+// (this method 0.08 .. 0.39; with only its second-order estimate 0.11 .. 3.4), the fast spin of
+// transient_auto_test.cpp 36 rtol, the bob hinged to a cantilever (joint_transient_test.cpp) 36
+// rtol at rtol 1e-7, the tumbling pair's energy over 10 s 955 rtol.
 // An estimate from the new state's forcing (first same as last, free: h (4 phi3 - phi2)
 // (N(z+) - N4)) came out about a hundred times below the second-order one and changed nothing.
 struct StepFunctions {

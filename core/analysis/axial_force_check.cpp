@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/model/element_kinematics.hpp"
+#include "core/model/stiffness.hpp"
 
 namespace beamrail {
 namespace {
@@ -78,6 +79,26 @@ struct Worst {
   }
 };
 
+// The correction e = -S^-1 (g0 + G e) of the displacements that the missing forces g0 of a state
+// make (their own change G e included), by a fixed-point iteration; false, with e = -S^-1 g0,
+// when it diverges.
+bool correction(const MissingAxialForces& missing, const Eigen::VectorXd& g0,
+                const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve,
+                Eigen::VectorXd* out) {
+  Eigen::VectorXd& e = *out;
+  e = -solve(g0);
+  double change = kInf;
+  for (int it = 0; it < 100 && e.allFinite(); ++it) {
+    const Eigen::VectorXd next = -solve(g0 + missing.of(e));
+    change = (next - e).norm();
+    e = next;
+    if (change <= 1e-3 * e.norm()) break;
+  }
+  if (e.allFinite() && change <= 1e-2 * e.norm()) return true;
+  e = -solve(g0);
+  return false;
+}
+
 }  // namespace
 
 MissingAxialForces::MissingAxialForces(const Model& model, const Data& data) : n_(model.n_dofs) {
@@ -125,8 +146,15 @@ void MissingAxialForces::build(const Model& model, const Data& data,
     } else {
       e.n = b.ea * (f.xi(0) - l) / l;
     }
-    if (!(e.n != 0.0) || !std::isfinite(e.n)) continue;
-    if (std::abs(e.n) > std::abs(forces_[g])) forces_[g] = e.n;
+    if (!std::isfinite(e.n)) continue;
+    e.eiy = b.eiy;
+    e.eiz = b.eiz;
+    e.ea = b.ea;
+    e.gj = b.gj;
+    if (e.n != 0.0) {
+      ++loaded_;
+      if (std::abs(e.n) > std::abs(forces_[g])) forces_[g] = e.n;
+    }
     elements_.push_back(e);
   }
 }
@@ -218,6 +246,75 @@ std::vector<double> MissingAxialForces::stiffness_energy(const Eigen::VectorXd& 
   return out;
 }
 
+std::vector<double> MissingAxialForces::bending_energy(const Eigen::VectorXd* v) const {
+  std::vector<double> out(names_.size(), 0.0);
+  for (const Element& e : elements_) {
+    Vec3 xi = e.offset, phi = e.turn;
+    if (v) change(e, *v, &xi, &phi);
+    const StiffnessBlocks<double> k(e.ea, e.gj, e.eiy, e.eiz, e.l);
+    Vec6 d;
+    d << 0.0, xi(1), xi(2), 0.0, phi(1), phi(2);
+    out[e.beam] += d.dot(k.k2(d));
+  }
+  return out;
+}
+
+double MissingAxialForces::element_ratio_bound() const {
+  // det(K_s - r K_b) = 0 per plane, K_s = N / (30 l) [36, -3 l; -3 l, 4 l^2], K_b = EI / l^3
+  // [12, -6 l; -6 l, 4 l^2]: 12 r^2 - 5.2 r s + 0.15 s^2 = 0 with s = N l^2 / EI, whose larger
+  // root is r = (5.2 + sqrt(19.84)) / 24 s = 0.4023 s.
+  constexpr double kLargest = 0.40225;
+  double bound = 0.0;
+  for (const Element& e : elements_) {
+    const double ei = std::min(e.eiy, e.eiz);
+    if (e.n == 0.0) continue;
+    if (!(ei > 0.0)) return kInf;
+    bound = std::max(bound, kLargest * std::abs(e.n) * e.l * e.l / ei);
+  }
+  return bound;
+}
+
+AxialForceEffect deformation_axial_force_effect(
+    const MissingAxialForces& missing,
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve) {
+  AxialForceEffect effect;
+  if (!missing.any()) return effect;
+  const Eigen::VectorXd g0 = missing.at_state();
+  if (!(g0.squaredNorm() > 0.0)) return effect;
+  Eigen::VectorXd e;
+  const bool converged = correction(missing, g0, solve, &e);
+  if (!e.allFinite()) return effect;
+  const std::vector<double> state = missing.bending_energy(nullptr);
+  const std::vector<double> change = missing.bending_energy(&e);
+  double most = 0.0;
+  for (double b : state) most = std::max(most, b);
+  if (!(most > 0.0)) return effect;
+  for (size_t g = 0; g < state.size(); ++g)
+    if (state[g] >= kAxialForceFloor * kAxialForceFloor * most)
+      effect.relative = std::max(effect.relative, std::sqrt(change[g] / state[g]));
+  if (!converged) effect.relative = kInf;
+  effect.beam = largest(missing.stiffness_energy(e));
+  if (effect.beam < 0) effect.beam = largest(missing.beam_forces());
+  return effect;
+}
+
+std::string transient_axial_force_warning(const MissingAxialForces& missing,
+                                          const AxialForceEffect& effect, double t) {
+  if (effect.beam < 0 || !(effect.relative > kAxialForceWarning)) return "";
+  char text[300];
+  if (std::isfinite(effect.relative))
+    std::snprintf(text, sizeof text,
+                  "the axial forces of the beams change the deformation by about %.3g of it (at "
+                  "t = %.6g s, the largest of the states measured) beyond what the model holds, ",
+                  effect.relative, t);
+  else
+    std::snprintf(text, sizeof text,
+                  "the axial forces of the beams change the deformation by more than it is (at "
+                  "t = %.6g s) beyond what the model holds, ",
+                  t);
+  return text + advice(missing, effect.beam, effect.relative);
+}
+
 AxialForceEffect static_axial_force_effect(
     const Model& model, const Data& data, const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve) {
@@ -252,18 +349,8 @@ AxialForceEffect static_axial_force_effect(
   for (int b : model.free_bodies) moved = std::max(moved, data.pose[b].u.norm());
   Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
   if (moved > 0.0 && g0.squaredNorm() > 0.0) {
-    // e = -S^-1 (g0 + G e): the missing forces of the corrected state.
-    e = -solve(g0);
-    double change = kInf;
-    for (int it = 0; it < 100 && e.allFinite(); ++it) {
-      const Eigen::VectorXd next = -solve(g0 + missing.of(e));
-      change = (next - e).norm();
-      e = next;
-      if (change <= 1e-3 * e.norm()) break;
-    }
-    if (!e.allFinite() || !(change <= 1e-2 * e.norm())) {
+    if (!correction(missing, g0, solve, &e)) {
       effect.relative = kInf;
-      e = -solve(g0);
     } else {
       const double floor = kAxialForceFloor * moved;
       for (int b : model.free_bodies) {

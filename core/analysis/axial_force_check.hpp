@@ -43,7 +43,7 @@ class MissingAxialForces {
   MissingAxialForces(const Model& model, const Data& data, const Eigen::VectorXd& direction);
 
   // Whether any element carries an axial force, and whether one is compressed.
-  bool any() const { return !elements_.empty(); }
+  bool any() const { return loaded_ > 0; }
   bool compressed() const;
 
   // The wrench vector (n_dofs, generalized forces on the free bodies) of the missing forces at
@@ -57,6 +57,14 @@ class MissingAxialForces {
   // The scene beams (a split beam's segments together) and their element counts.
   const std::vector<std::string>& beam_names() const { return names_; }
   const std::vector<int>& beam_elements() const { return counts_; }
+  // Per scene beam: d^T K_b d summed over its elements, d the bending offsets and turns of the
+  // elements' right ends in their left ends' frames (xi_y, xi_z, phi_y, phi_z) at the state
+  // (v: nullptr) or their change for the generalized displacement *v, K_b the law's bending
+  // blocks (core/model/stiffness.hpp).
+  std::vector<double> bending_energy(const Eigen::VectorXd* v) const;
+  // A bound on d^T K_s d / d^T K_b d of any element (the largest eigenvalue of K_b^-1 K_s per
+  // plane, 0.402 |N| l^2 / EI): below it, no deformation's missing stiffness is larger.
+  double element_ratio_bound() const;
   // Per scene beam: the axial force of largest magnitude among its elements [N] (tension > 0).
   const std::vector<double>& beam_forces() const { return forces_; }
 
@@ -71,6 +79,7 @@ class MissingAxialForces {
     Vec3 offset;                 // xi: point 2 in the left end's frame
     Vec3 turn;                   // phi: the right end's rotation measure in that frame
     double n = 0.0, l = 0.0;     // axial force [N], length [m]
+    double ea = 0.0, gj = 0.0, eiy = 0.0, eiz = 0.0;  // the beam's rigidities
   };
   // The elements at the state, their axial forces from the state (direction: nullptr) or from
   // the first-order change along *direction.
@@ -87,6 +96,7 @@ class MissingAxialForces {
   std::vector<std::string> names_;
   std::vector<int> counts_;
   std::vector<double> forces_;
+  int loaded_ = 0;  // elements with an axial force
 };
 
 // What the missing forces do to a static equilibrium; `solve` applies S^-1 (the factorized
@@ -102,6 +112,21 @@ struct AxialForceEffect {
 AxialForceEffect static_axial_force_effect(
     const Model& model, const Data& data, const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve);
+
+// What the missing forces do to the deformation of a state that is not an equilibrium (a
+// transient's: moving, deformed by loads and inertia), the response to them taken as
+// quasi-static: the same correction e as static_axial_force_effect's, measured on the elements
+// rather than on the displacements (which hold the motion): per scene beam, the bending offsets
+// and turns e changes over the state's own, sqrt(e^T K_b e / d^T K_b d) (bending_energy), over
+// the beams bent with at least kAxialForceFloor^2 of the most bent one's energy; the largest.
+// `unstable` is not measured.
+AxialForceEffect deformation_axial_force_effect(
+    const MissingAxialForces& missing,
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve);
+
+// The warning for a transient's state at time t [s], "" below kAxialForceWarning.
+std::string transient_axial_force_warning(const MissingAxialForces& missing,
+                                          const AxialForceEffect& effect, double t);
 
 // The warning for a static equilibrium, "" when the effect is below kAxialForceWarning.
 std::string static_axial_force_warning(const MissingAxialForces& missing,

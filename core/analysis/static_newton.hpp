@@ -114,6 +114,10 @@ class TangentSolver {
   TangentSolver(const TangentSolver&) = delete;
   TangentSolver& operator=(const TangentSolver&) = delete;
 
+  // Largest tangent that a singular or ill-conditioned factorization falls back to the dense
+  // minimum-norm solution for (n^3: about 3 s at 3,000 rows); above it factorize() fails.
+  long dense_limit = 3000;
+
   // The tangent's values in the pattern's compressed columns (matrix() views them).
   bool factorize(const Model& model, const Data& data, std::string* failure) {
     use_dense_ = false;
@@ -163,7 +167,7 @@ class TangentSolver {
         if (r.norm() <= 1e-8 * probe.norm()) return true;
       }
     }
-    if (s.rows() > 3000) {
+    if (s.rows() > dense_limit) {
       *failure = held_by_beams(model)
                      ? "the tangent stiffness is singular or indefinite: the structure buckles or "
                        "snaps through under these loads"

@@ -7,6 +7,7 @@
 #include <exception>
 #include <stdexcept>
 
+#include "core/analysis/axial_force_watch.hpp"
 #include "core/analysis/deformation_check.hpp"
 #include "core/analysis/integrators.hpp"
 #include "core/analysis/sundials_support.hpp"
@@ -190,17 +191,19 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     result.warnings = integrator->warnings;
     result.jacobian_nonzeros = integrator->nnz;
 
-    const auto deliver = [&](double t) {
+    const long n_out =
+        std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
+    AxialForceWatch axial(model, options.structure_cache, n_out);
+    const auto deliver = [&](long k, double t) {
       const TransientSample s = sample_at(model, data, t, y.data());
       deformation.observe(model, data, t);
+      axial.observe(model, data, k, t);
       if (observer) observer(s, data);
     };
-    deliver(0.0);
+    deliver(0, 0.0);
 
     const std::vector<double> breakpoints = time_breakpoints(model, options.t_end);
     size_t next_break = 0;
-    const long n_out =
-        std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
     double t = 0.0;
     result.ok = true;
     // Times closer than this are one time: an output time and a breakpoint computed apart (110 x
@@ -238,7 +241,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
           integrator->restart(t, y);
         }
       }
-      if (result.ok) deliver(t_out);
+      if (result.ok) deliver(k, t_out);
       // An element outside the range of its law ends the run (checked at accepted states).
       if (std::string range = element_out_of_range(model, data); result.ok && !range.empty()) {
         result.ok = false;
@@ -256,6 +259,11 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
       if (std::find(result.warnings.begin(), result.warnings.end(), w) == result.warnings.end())
         result.warnings.push_back(w);
     for (std::string& w : integrator->closing_warnings()) result.warnings.push_back(std::move(w));
+    result.axial_force_effect = axial.largest();
+    result.axial_force_time = axial.when();
+    result.axial_force_states = axial.measured();
+    for (const std::string* w : {&axial.warning(), &axial.unmeasured_warning()})
+      if (!w->empty()) result.warnings.push_back(*w);
   } catch (const std::exception& e) {
     result.ok = false;
     result.message = e.what();

@@ -139,6 +139,12 @@ struct TransientResult {
   // The band a modal phase integrated [Hz] (Integrator::band_hz): given, or chosen for rtol; 0:
   // every mode.
   double max_frequency_hz = 0.0;
+  // The check of the elements' own axial forces (core/analysis/axial_force_watch.hpp): the
+  // largest relative change of the deformation it measured, when [s], and over how many states
+  // (0: none needed measuring).
+  double axial_force_effect = 0.0;
+  double axial_force_time = 0.0;
+  int axial_force_states = 0;
 };
 inline constexpr size_t kMaxRecordedPhases = 20;
 

@@ -335,6 +335,9 @@ class Runner {
     // The band integrated: chosen for rtol ("auto", or by auto on a large scene) or given.
     report.max_frequency_hz = result.max_frequency_hz > 0.0 ? result.max_frequency_hz
                                                             : options.integrator.max_frequency_hz;
+    report.axial_force_effect = result.axial_force_effect;
+    report.axial_force_time = result.axial_force_time;
+    report.axial_force_states = result.axial_force_states;
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);

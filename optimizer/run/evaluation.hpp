@@ -61,6 +61,10 @@ struct AnalysisReport {
   std::vector<MethodPhase> phases;
   long phase_count = 0;
   double max_frequency_hz = 0.0;  // the band integrated (0: every mode) [Hz]
+  // The elements' own axial forces: the largest relative change of the deformation measured,
+  // when [s], over how many states (TransientResult).
+  double axial_force_effect = 0.0, axial_force_time = 0.0;
+  int axial_force_states = 0;
   std::optional<Verification> verification;
   // static (also the equilibrium a modal or buckling analysis is linearized about, or that a
   // transient starts from)

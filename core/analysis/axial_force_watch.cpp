@@ -1,6 +1,7 @@
 #include "core/analysis/axial_force_watch.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 
 #include "core/analysis/axial_force_check.hpp"
@@ -16,6 +17,14 @@ AxialForceWatch::AxialForceWatch(const Model& model, SparseStructureCache* cache
 
 void AxialForceWatch::observe(const Model& model, const Data& data, long index, double t) {
   if (index % stride_ != 0 && index != outputs_) return;
+  const auto start = std::chrono::steady_clock::now();
+  struct Clock {
+    std::chrono::steady_clock::time_point start;
+    double* seconds;
+    ~Clock() {
+      *seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+  } clock{start, &seconds_};
   const MissingAxialForces missing(model, data);
   if (!missing.any() || missing.element_ratio_bound() < kAxialForceNegligible) return;
   if (!solver_) {

@@ -49,6 +49,8 @@ class AxialForceWatch {
   double largest() const { return largest_; }
   double when() const { return when_; }
   int measured() const { return measured_; }
+  // The wall time the check took [s].
+  double seconds() const { return seconds_; }
   int unmeasured() const { return unmeasured_; }
   // The warning for states not measured whose bound reached kAxialForceWarning, "" else.
   const std::string& unmeasured_warning() const { return unmeasured_warning_; }
@@ -58,7 +60,7 @@ class AxialForceWatch {
   SparseStructureCache* cache_ = nullptr;
   std::unique_ptr<statics::TangentSolver> solver_;
   long stride_ = 1, outputs_ = 0;
-  double largest_ = 0.0, when_ = 0.0;
+  double largest_ = 0.0, when_ = 0.0, seconds_ = 0.0;
   int measured_ = 0, unmeasured_ = 0;
   std::string warning_, unmeasured_warning_;
 };

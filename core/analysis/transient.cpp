@@ -262,6 +262,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     result.axial_force_effect = axial.largest();
     result.axial_force_time = axial.when();
     result.axial_force_states = axial.measured();
+    result.axial_force_seconds = axial.seconds();
     for (const std::string* w : {&axial.warning(), &axial.unmeasured_warning()})
       if (!w->empty()) result.warnings.push_back(*w);
   } catch (const std::exception& e) {

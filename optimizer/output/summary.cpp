@@ -104,7 +104,8 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       if (a.axial_force_states > 0)
         j["axial_force_check"] = {{"states", a.axial_force_states},
                                   {"largest", a.axial_force_effect},
-                                  {"t", a.axial_force_time}};
+                                  {"t", a.axial_force_time},
+                                  {"wall_seconds", a.axial_force_seconds}};
       j["steps"] = a.stats.steps;
       j["rhs_evaluations"] = a.stats.rhs_evaluations;
       j["jacobian_evaluations"] = a.stats.jacobian_evaluations;

@@ -338,6 +338,7 @@ class Runner {
     report.axial_force_effect = result.axial_force_effect;
     report.axial_force_time = result.axial_force_time;
     report.axial_force_states = result.axial_force_states;
+    report.axial_force_seconds = result.axial_force_seconds;
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);

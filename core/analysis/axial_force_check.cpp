@@ -87,16 +87,37 @@ bool correction(const MissingAxialForces& missing, const Eigen::VectorXd& g0,
                 Eigen::VectorXd* out) {
   Eigen::VectorXd& e = *out;
   e = -solve(g0);
+  // Growing 1e6 times past the first-order correction is divergence (and keeps the norms below
+  // overflow, where inf <= inf once passed for convergence).
+  const double most = 1e6 * e.norm();
   double change = kInf;
-  for (int it = 0; it < 100 && e.allFinite(); ++it) {
+  for (int it = 0; it < 100 && e.allFinite() && e.norm() <= most; ++it) {
     const Eigen::VectorXd next = -solve(g0 + missing.of(e));
     change = (next - e).norm();
     e = next;
     if (change <= 1e-3 * e.norm()) break;
   }
-  if (e.allFinite() && change <= 1e-2 * e.norm()) return true;
+  if (e.allFinite() && e.norm() <= most && change <= 1e-2 * e.norm()) return true;
   e = -solve(g0);
   return false;
+}
+
+// Per free body, its correction over its displacement along it (at least kAxialForceFloor of the
+// largest displacement of any body); the largest. 0 when nothing moved.
+double body_relative(const Model& model, const Data& data, const Eigen::VectorXd& e) {
+  double moved = 0.0;
+  for (int b : model.free_bodies) moved = std::max(moved, data.pose[b].u.norm());
+  if (!(moved > 0.0)) return 0.0;
+  const double floor = kAxialForceFloor * moved;
+  double relative = 0.0;
+  for (int b : model.free_bodies) {
+    const int k = model.bodies[b].free_index;
+    const Vec3 c = e.segment<3>(kD * k);
+    if (!(c.norm() > 0.0)) continue;
+    const double along = std::abs(data.pose[b].u.dot(c.normalized()));
+    relative = std::max(relative, c.norm() / std::max(along, floor));
+  }
+  return relative;
 }
 
 }  // namespace
@@ -275,25 +296,31 @@ double MissingAxialForces::element_ratio_bound() const {
 }
 
 AxialForceEffect deformation_axial_force_effect(
-    const MissingAxialForces& missing,
+    const Model& model, const Data& data, const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve) {
   AxialForceEffect effect;
   if (!missing.any()) return effect;
   const Eigen::VectorXd g0 = missing.at_state();
   if (!(g0.squaredNorm() > 0.0)) return effect;
+  // Where the iteration diverges (the missing stiffness outweighs the structure's along e: in
+  // tension it only stiffens, in compression it may leave none), correction's first-order e,
+  // whose measure is then large: a warning either way.
   Eigen::VectorXd e;
-  const bool converged = correction(missing, g0, solve, &e);
+  correction(missing, g0, solve, &e);
   if (!e.allFinite()) return effect;
   const std::vector<double> state = missing.bending_energy(nullptr);
   const std::vector<double> change = missing.bending_energy(&e);
   double most = 0.0;
   for (double b : state) most = std::max(most, b);
   if (!(most > 0.0)) return effect;
-  for (size_t g = 0; g < state.size(); ++g)
-    if (state[g] >= kAxialForceFloor * kAxialForceFloor * most)
-      effect.relative = std::max(effect.relative, std::sqrt(change[g] / state[g]));
-  if (!converged) effect.relative = kInf;
-  effect.beam = largest(missing.stiffness_energy(e));
+  for (size_t g = 0; g < state.size(); ++g) {
+    if (!(state[g] >= kAxialForceFloor * kAxialForceFloor * most)) continue;
+    const double relative = std::sqrt(change[g] / state[g]);
+    if (relative > effect.relative) {
+      effect.relative = relative;
+      effect.beam = static_cast<int>(g);
+    }
+  }
   if (effect.beam < 0) effect.beam = largest(missing.beam_forces());
   return effect;
 }
@@ -349,18 +376,10 @@ AxialForceEffect static_axial_force_effect(
   for (int b : model.free_bodies) moved = std::max(moved, data.pose[b].u.norm());
   Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
   if (moved > 0.0 && g0.squaredNorm() > 0.0) {
-    if (!correction(missing, g0, solve, &e)) {
+    if (!correction(missing, g0, solve, &e))
       effect.relative = kInf;
-    } else {
-      const double floor = kAxialForceFloor * moved;
-      for (int b : model.free_bodies) {
-        const int k = model.bodies[b].free_index;
-        const Vec3 c = e.segment<3>(kD * k);
-        if (!(c.norm() > 0.0)) continue;
-        const double along = std::abs(data.pose[b].u.dot(c.normalized()));
-        effect.relative = std::max(effect.relative, c.norm() / std::max(along, floor));
-      }
-    }
+    else
+      effect.relative = body_relative(model, data, e);
   }
   if (!e.allFinite()) e = Eigen::VectorXd::Zero(n);
   effect.beam = largest(missing.stiffness_energy(e));

@@ -62,8 +62,10 @@ class MissingAxialForces {
   // (v: nullptr) or their change for the generalized displacement *v, K_b the law's bending
   // blocks (core/model/stiffness.hpp).
   std::vector<double> bending_energy(const Eigen::VectorXd* v) const;
-  // A bound on d^T K_s d / d^T K_b d of any element (the largest eigenvalue of K_b^-1 K_s per
-  // plane, 0.402 |N| l^2 / EI): below it, no deformation's missing stiffness is larger.
+  // The largest d^T K_s d / d^T K_b d of any element and deformation d (the largest eigenvalue
+  // of K_b^-1 K_s per plane, 0.402 |N| l^2 / EI). What the missing stiffness does to a result
+  // also passes through the structure's flexibility (large near buckling), so this bounds an
+  // element, not an effect.
   double element_ratio_bound() const;
   // Per scene beam: the axial force of largest magnitude among its elements [N] (tension > 0).
   const std::vector<double>& beam_forces() const { return forces_; }
@@ -113,15 +115,18 @@ AxialForceEffect static_axial_force_effect(
     const Model& model, const Data& data, const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve);
 
-// What the missing forces do to the deformation of a state that is not an equilibrium (a
-// transient's: moving, deformed by loads and inertia), the response to them taken as
-// quasi-static: the same correction e as static_axial_force_effect's, measured on the elements
-// rather than on the displacements (which hold the motion): per scene beam, the bending offsets
-// and turns e changes over the state's own, sqrt(e^T K_b e / d^T K_b d) (bending_energy), over
-// the beams bent with at least kAxialForceFloor^2 of the most bent one's energy; the largest.
-// `unstable` is not measured.
+// What the missing forces do to a state that is not an equilibrium (a transient's: moving,
+// deformed by loads and inertia), the response to them taken as quasi-static: the same
+// correction e as static_axial_force_effect's (S the tangent at the state), measured on the
+// elements rather than on the displacements (which hold the motion, and whose momentary values
+// need not follow the deformation: per body, the static measure gave 1.56 on
+// studies/frame_3d.json's transient where a body passed near its start): per scene beam, the
+// bending offsets and turns e changes over the state's own,
+// sqrt(e^T K_b e / d^T K_b d) (bending_energy), over the beams bent with at least
+// kAxialForceFloor^2 of the most bent one's energy; the largest, and that beam. Where the
+// fixed-point iteration diverges, of the first-order e = -S^-1 g0. `unstable` is not measured.
 AxialForceEffect deformation_axial_force_effect(
-    const MissingAxialForces& missing,
+    const Model& model, const Data& data, const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve);
 
 // The warning for a transient's state at time t [s], "" below kAxialForceWarning.

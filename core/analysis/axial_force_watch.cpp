@@ -16,7 +16,6 @@ AxialForceWatch::AxialForceWatch(const Model& model, SparseStructureCache* cache
       outputs_(outputs) {}
 
 void AxialForceWatch::observe(const Model& model, const Data& data, long index, double t) {
-  if (index % stride_ != 0 && index != outputs_) return;
   const auto start = std::chrono::steady_clock::now();
   struct Clock {
     std::chrono::steady_clock::time_point start;
@@ -26,7 +25,15 @@ void AxialForceWatch::observe(const Model& model, const Data& data, long index, 
     }
   } clock{start, &seconds_};
   const MissingAxialForces missing(model, data);
-  if (!missing.any() || missing.element_ratio_bound() < kAxialForceNegligible) return;
+  if (!missing.any()) return;
+  const double bound = missing.element_ratio_bound();
+  if (!(bound >= kAxialForceNegligible)) return;
+  // The regular states, and any whose bound is the largest yet (a passing pulse of force).
+  const bool regular = index % stride_ == 0 || index == outputs_;
+  const bool peak = bound > largest_bound_ && extra_ < kAxialForceStates;
+  largest_bound_ = std::max(largest_bound_, bound);
+  if (!regular && !peak) return;
+  if (!regular) ++extra_;
   if (!solver_) {
     solver_ = std::make_unique<statics::TangentSolver>(
         cache_ ? cache_->get(model) : std::make_shared<const SparseStructure>(model));
@@ -39,24 +46,25 @@ void AxialForceWatch::observe(const Model& model, const Data& data, long index, 
   std::string why;
   if (!solver_->factorize(model, data_, &why)) {
     ++unmeasured_;
-    const double bound = missing.element_ratio_bound();
-    if (bound >= kAxialForceWarning && unmeasured_warning_.empty()) {
-      char text[160];
-      std::snprintf(text, sizeof text,
-                    "the check of the beams' axial forces could not measure the state at t = "
-                    "%.6g s (%s)",
-                    t, why.c_str());
-      char bound_text[40];
-      std::snprintf(bound_text, sizeof bound_text, "%.3g", bound);
-      unmeasured_warning_ = std::string(text) +
-                            ": an element's own axial force may change its bending by up to " +
-                            bound_text + " of it (docs/model.md \"Axial force and bending\")";
+    if (bound > unmeasured_bound_) {
+      unmeasured_bound_ = bound;
+      char text[80];
+      std::snprintf(text, sizeof text, "at t = %.6g s (", t);
+      char tail[120];
+      std::snprintf(tail, sizeof tail,
+                    "): an element's own axial force changes its bending by up to %.3g of it",
+                    bound);
+      unmeasured_warning_ =
+          "the check of the beams' axial forces could not measure " +
+          std::to_string(unmeasured_) + " state(s), the one of the largest force " + text + why +
+          tail + " (docs/model.md \"Axial force and bending\"; more segments reduce it as 1/n^2)";
+      if (bound < kAxialForceWarning) unmeasured_warning_.clear();
     }
     return;
   }
   ++measured_;
   const AxialForceEffect effect = deformation_axial_force_effect(
-      missing, [&](const Eigen::VectorXd& b) { return solver_->solve(b); });
+      model, data, missing, [&](const Eigen::VectorXd& b) { return solver_->solve(b); });
   if (!(effect.relative > largest_)) return;
   largest_ = effect.relative;
   when_ = t;

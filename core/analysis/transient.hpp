@@ -145,6 +145,7 @@ struct TransientResult {
   double axial_force_effect = 0.0;
   double axial_force_time = 0.0;
   int axial_force_states = 0;
+  int axial_force_unmeasured = 0;    // states whose tangent could not be factorized
   double axial_force_seconds = 0.0;  // what the check cost
 };
 inline constexpr size_t kMaxRecordedPhases = 20;

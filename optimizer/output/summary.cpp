@@ -101,10 +101,11 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
         j["phase_count"] = a.phase_count;
       }
       if (a.max_frequency_hz > 0.0) j["max_frequency_hz"] = a.max_frequency_hz;
-      if (a.axial_force_states > 0)
+      if (a.axial_force_states > 0 || a.axial_force_unmeasured > 0)
         j["axial_force_check"] = {{"states", a.axial_force_states},
                                   {"largest", a.axial_force_effect},
                                   {"t", a.axial_force_time},
+                                  {"unmeasured", a.axial_force_unmeasured},
                                   {"wall_seconds", a.axial_force_seconds}};
       j["steps"] = a.stats.steps;
       j["rhs_evaluations"] = a.stats.rhs_evaluations;

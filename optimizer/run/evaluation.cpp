@@ -339,6 +339,7 @@ class Runner {
     report.axial_force_time = result.axial_force_time;
     report.axial_force_states = result.axial_force_states;
     report.axial_force_seconds = result.axial_force_seconds;
+    report.axial_force_unmeasured = result.axial_force_unmeasured;
     report.wall_seconds = result.stats.wall_seconds;
     report.t_reached = result.t_reached;
     add_warnings(result.warnings);

@@ -64,7 +64,7 @@ struct AnalysisReport {
   // The elements' own axial forces: the largest relative change of the deformation measured,
   // when [s], over how many states (TransientResult).
   double axial_force_effect = 0.0, axial_force_time = 0.0;
-  int axial_force_states = 0;
+  int axial_force_states = 0, axial_force_unmeasured = 0;
   double axial_force_seconds = 0.0;
   std::optional<Verification> verification;
   // static (also the equilibrium a modal or buckling analysis is linearized about, or that a

@@ -55,9 +55,9 @@ void AxialForceWatch::observe(const Model& model, const Data& data, long index, 
                     "): an element's own axial force changes its bending by up to %.3g of it",
                     bound);
       unmeasured_warning_ =
-          "the check of the beams' axial forces could not measure " +
-          std::to_string(unmeasured_) + " state(s), the one of the largest force " + text + why +
-          tail + " (docs/model.md \"Axial force and bending\"; more segments reduce it as 1/n^2)";
+          "the check of the beams' axial forces could not measure " + std::to_string(unmeasured_) +
+          " state(s), the one of the largest force " + text + why + tail +
+          " (docs/model.md \"Axial force and bending\"; more segments reduce it as 1/n^2)";
       if (bound < kAxialForceWarning) unmeasured_warning_.clear();
     }
     return;

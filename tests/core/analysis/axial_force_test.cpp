@@ -35,11 +35,10 @@ constexpr double kSide = 100.0;  // [N]
 std::string column(double axial, int segments, double side = kSide, bool reversed = false,
                    double density = 1.0, double side_at = -1.0) {
   const std::string side_load =
-      side_at >= 0.0 ? R"(, {"type": "force", "body": "head", "value": [0, )" +
-                           std::to_string(side) +
-                           R"(, 0], "time": {"type": "step", "at": )" +
-                           std::to_string(side_at) + "}}"
-                     : "";
+      side_at >= 0.0
+          ? R"(, {"type": "force", "body": "head", "value": [0, )" + std::to_string(side) +
+                R"(, 0], "time": {"type": "step", "at": )" + std::to_string(side_at) + "}}"
+          : "";
   if (side_at >= 0.0) side = 0.0;
   return R"({"materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": )" +
          std::to_string(density) + R"(}},
@@ -218,6 +217,19 @@ TEST(AxialForce, BucklingWarnsWhatTheBeamsOwnAxialForcesLeaveOut) {
   }
 }
 
+// A transient by auto from the static equilibrium of the loads at t = 0 (*st: that analysis).
+testing::TransientRun from_equilibrium(const Model& model, TransientOptions options,
+                                       StaticResult* st) {
+  Data equilibrium(model);
+  StaticOptions at_start;
+  at_start.time = 0.0;
+  *st = solve_static(model, at_start, equilibrium);
+  options.integrator.method = IntegratorMethod::kAuto;
+  options.initial_state.resize(model.n_states);
+  initial_state_at(model, equilibrium, options.initial_state.data());
+  return testing::simulate(model, options);
+}
+
 // A transient from the equilibrium under the axial force (60 kN of compression, 0.78 of
 // Euler's load), the side load a step at 10 ms: the head swings to about twice the static sway
 // and back. The warning's value (the largest relative change of the deformation the missing
@@ -230,16 +242,10 @@ TEST(AxialForce, ATransientWarnsWhatTheBeamsOwnAxialForcesLeaveOut) {
   const auto peak = [](int segments, double* warning, TransientResult* out) {
     const Model model =
         testing::scene_from_json(column(-60e3, segments, kSide, false, 100.0, 0.01));
-    Data equilibrium(model);
-    StaticOptions at_start;
-    at_start.time = 0.0;
-    const StaticResult st = solve_static(model, at_start, equilibrium);
+    StaticResult st;
+    const testing::TransientRun run =
+        from_equilibrium(model, testing::options(0.5, 0.005, 1e-6, 1e-10), &st);
     EXPECT_TRUE(st.ok) << st.message;
-    TransientOptions options = testing::options(0.5, 0.005, 1e-6, 1e-10);
-    options.integrator.method = IntegratorMethod::kAuto;
-    options.initial_state.resize(model.n_states);
-    initial_state_at(model, equilibrium, options.initial_state.data());
-    const testing::TransientRun run = testing::simulate(model, options);
     EXPECT_TRUE(run.result.ok) << run.result.message;
     const int head = testing::body_index(model, "head");
     double most = 0.0;
@@ -281,14 +287,10 @@ TEST(AxialForce, ATransientWarnsWhatTheBeamsOwnAxialForcesLeaveOut) {
 TEST(AxialForce, ATransientAtAnEquilibriumWarnsAsTheStaticAnalysis) {
   for (int segments : {0, 4}) {
     const Model model = testing::scene_from_json(column(2e3, segments));
-    Data equilibrium(model);
-    const StaticResult st = solve_static(model, StaticOptions{}, equilibrium);
+    StaticResult st;
+    const testing::TransientRun run =
+        from_equilibrium(model, testing::options(0.02, 0.01, 1e-6, 1e-12), &st);
     ASSERT_TRUE(st.ok) << st.message;
-    TransientOptions options = testing::options(0.02, 0.01, 1e-6, 1e-12);
-    options.integrator.method = IntegratorMethod::kAuto;
-    options.initial_state.resize(model.n_states);
-    initial_state_at(model, equilibrium, options.initial_state.data());
-    const testing::TransientRun run = testing::simulate(model, options);
     ASSERT_TRUE(run.result.ok) << run.result.message;
     const int head = testing::body_index(model, "head");
     const double error = std::abs(exact_sway(2e3) / run.samples.back().pose[head].u.y() - 1.0);

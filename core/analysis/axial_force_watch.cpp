@@ -50,15 +50,7 @@ void AxialForceWatch::observe(const Model& model, const Data& data, long index, 
       unmeasured_bound_ = bound;
       char text[80];
       std::snprintf(text, sizeof text, "at t = %.6g s (", t);
-      char tail[120];
-      std::snprintf(tail, sizeof tail,
-                    "): an element's own axial force changes its bending by up to %.3g of it",
-                    bound);
-      unmeasured_warning_ =
-          "the check of the beams' axial forces could not measure " + std::to_string(unmeasured_) +
-          " state(s), the one of the largest force " + text + why + tail +
-          " (docs/model.md \"Axial force and bending\"; more segments reduce it as 1/n^2)";
-      if (bound < kAxialForceWarning) unmeasured_warning_.clear();
+      unmeasured_at_ = text + why + ")";
     }
     return;
   }
@@ -69,6 +61,17 @@ void AxialForceWatch::observe(const Model& model, const Data& data, long index, 
   largest_ = effect.relative;
   when_ = t;
   warning_ = transient_axial_force_warning(missing, effect, t);
+}
+
+std::string AxialForceWatch::unmeasured_warning() const {
+  if (!(unmeasured_bound_ >= kAxialForceWarning)) return "";
+  char tail[120];
+  std::snprintf(tail, sizeof tail,
+                ": an element's own axial force changes its bending by up to %.3g of it",
+                unmeasured_bound_);
+  return "the check of the beams' axial forces could not measure " + std::to_string(unmeasured_) +
+         " state(s), the one of the largest force " + unmeasured_at_ + tail +
+         " (docs/model.md \"Axial force and bending\"; more segments reduce it as 1/n^2)";
 }
 
 }  // namespace beamrail

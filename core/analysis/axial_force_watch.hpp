@@ -57,7 +57,7 @@ class AxialForceWatch {
   int unmeasured() const { return unmeasured_; }
   // The warning for states not measured, "" unless the largest bound among them reached
   // kAxialForceWarning.
-  const std::string& unmeasured_warning() const { return unmeasured_warning_; }
+  std::string unmeasured_warning() const;
 
  private:
   Data data_;
@@ -67,7 +67,8 @@ class AxialForceWatch {
   double largest_ = 0.0, when_ = 0.0, seconds_ = 0.0;
   double largest_bound_ = 0.0, unmeasured_bound_ = 0.0;
   int measured_ = 0, unmeasured_ = 0, extra_ = 0;
-  std::string warning_, unmeasured_warning_;
+  std::string warning_;
+  std::string unmeasured_at_;  // when and why the state of the largest bound was not measured
 };
 
 }  // namespace beamrail

@@ -264,8 +264,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     result.axial_force_states = axial.measured();
     result.axial_force_seconds = axial.seconds();
     result.axial_force_unmeasured = axial.unmeasured();
-    for (const std::string* w : {&axial.warning(), &axial.unmeasured_warning()})
-      if (!w->empty()) result.warnings.push_back(*w);
+    for (std::string w : {axial.warning(), axial.unmeasured_warning()})
+      if (!w.empty()) result.warnings.push_back(std::move(w));
   } catch (const std::exception& e) {
     result.ok = false;
     result.message = e.what();

@@ -35,48 +35,124 @@ int threads_for(long rows, long cols, long parts) {
   return 1;
 }
 
-// y = a x for kVectors right-hand sides (x: cols x kVectors, y: rows x kVectors, column-major),
-// written with the compiler's vector types: per kLanes rows, the kVectors partial sums stay in
-// registers over kBlock = 8 matrix columns (y is loaded and stored once per 8 columns). kLanes:
-// 8 doubles (one AVX-512 register, two AVX2 ones) or 4 (one AVX2 register). Measured at n = 1038
-// on the reference machine (AVX-512): three pairs in one pass (8 lanes) 302 us, three passes of
-// plain loops that the compiler vectorized 502 us; on an AVX2 machine (AMD EPYC) a pair with 4
-// lanes 230 us, with those plain loops 350 us, one vector 179 against 183 us (and 78 against 83
-// us at 6,000 x 95, 6.3 against 8.5 us at n = 240).
+// The kernels' pieces. y = a x for kVectors right-hand sides (x: cols x kVectors, y: rows x
+// kVectors, column-major) is summed per kLanes rows over kBlock = 8 matrix columns at a time, the
+// kVectors partial sums in registers (y is loaded and stored once per 8 columns), written with
+// the compiler's vector types. kLanes: 8 doubles (one AVX-512 register, two AVX2 ones) or 4 (one
+// AVX2 register). Measured at n = 1038 on the reference machine (AVX-512): three pairs in one
+// pass (8 lanes) 302 us, three passes of plain loops that the compiler vectorized 502 us; on an
+// AVX2 machine (AMD EPYC) a pair with 4 lanes 230 us, with those plain loops 350 us, one vector
+// 179 against 183 us (and 78 against 83 us at 6,000 x 95, 6.3 against 8.5 us at n = 240). Every
+// entry of y is summed over the columns in their order whatever the blocking, so a pass that
+// computes x on its way (transposed_then) gives the bits of one that is given it.
+constexpr int kBlock = 8;
+
+template <int kVectors>
+[[gnu::always_inline]] inline void zero(long rows, double* __restrict y, long ldy) {
+  for (int v = 0; v < kVectors; ++v)
+    for (long i = 0; i < rows; ++i) y[v * ldy + i] = 0.0;
+}
+
+// y += a(:, k .. k + 7) x(k .. k + 7, :), `col` pointing at column k.
+template <int kVectors, int kLanes>
+[[gnu::always_inline]] inline void add_block(long rows, const double* __restrict col, long lda,
+                                             const double* x, long cols, long k,
+                                             double* __restrict y, long ldy) {
+  typedef double Lanes __attribute__((vector_size(8 * kLanes)));
+  const long body = rows - rows % kLanes;
+  double p[kVectors][kBlock];
+  for (int v = 0; v < kVectors; ++v)
+    for (int j = 0; j < kBlock; ++j) p[v][j] = x[v * cols + k + j];
+  for (long i = 0; i < body; i += kLanes) {
+    Lanes s[kVectors];
+    for (int v = 0; v < kVectors; ++v) std::memcpy(&s[v], y + v * ldy + i, sizeof(Lanes));
+    for (int j = 0; j < kBlock; ++j) {
+      Lanes c;
+      std::memcpy(&c, col + j * lda + i, sizeof c);
+      for (int v = 0; v < kVectors; ++v) s[v] += p[v][j] * c;
+    }
+    for (int v = 0; v < kVectors; ++v) std::memcpy(y + v * ldy + i, &s[v], sizeof(Lanes));
+  }
+  for (long i = body; i < rows; ++i)
+    for (int j = 0; j < kBlock; ++j)
+      for (int v = 0; v < kVectors; ++v) y[v * ldy + i] += p[v][j] * col[j * lda + i];
+}
+
+// y += a(:, k) x(k, :): a column after the last whole block.
+template <int kVectors>
+[[gnu::always_inline]] inline void add_column(long rows, const double* __restrict a, long lda,
+                                              const double* x, long cols, long k,
+                                              double* __restrict y, long ldy) {
+  for (int v = 0; v < kVectors; ++v) {
+    const double p = x[v * cols + k];
+    for (long i = 0; i < rows; ++i) y[v * ldy + i] += p * a[k * lda + i];
+  }
+}
+
 template <int kVectors, int kLanes = 8>
 [[gnu::always_inline]] inline void wide_kernel(long rows, long cols, const double* __restrict a,
                                                long lda, const double* __restrict x,
                                                double* __restrict y, long ldy) {
-  typedef double Lanes __attribute__((vector_size(8 * kLanes)));
-  constexpr int kBlock = 8;
-  const long body = rows - rows % kLanes;
-  for (int v = 0; v < kVectors; ++v)
-    for (long i = 0; i < rows; ++i) y[v * ldy + i] = 0.0;
+  zero<kVectors>(rows, y, ldy);
   long k = 0;
-  for (; k + kBlock <= cols; k += kBlock) {
-    double p[kVectors][kBlock];
-    for (int v = 0; v < kVectors; ++v)
-      for (int j = 0; j < kBlock; ++j) p[v][j] = x[v * cols + k + j];
-    const double* col = a + k * lda;
-    for (long i = 0; i < body; i += kLanes) {
-      Lanes s[kVectors];
-      for (int v = 0; v < kVectors; ++v) std::memcpy(&s[v], y + v * ldy + i, sizeof(Lanes));
-      for (int j = 0; j < kBlock; ++j) {
-        Lanes c;
-        std::memcpy(&c, col + j * lda + i, sizeof c);
-        for (int v = 0; v < kVectors; ++v) s[v] += p[v][j] * c;
-      }
-      for (int v = 0; v < kVectors; ++v) std::memcpy(y + v * ldy + i, &s[v], sizeof(Lanes));
+  for (; k + kBlock <= cols; k += kBlock)
+    add_block<kVectors, kLanes>(rows, a + k * lda, lda, x, cols, k, y, ldy);
+  for (; k < cols; ++k) add_column<kVectors>(rows, a, lda, x, cols, k, y, ldy);
+}
+
+// y_j = sum_i a_ij x_i for the kColumns columns from j of the rows x cols matrix a (a^T x): against
+// one load of x, each sum in 4-double vectors (one AVX2 register) over the rows, the last
+// rows % 4 added after. Each column is summed alone, so the bits do not depend on how the
+// columns are grouped or shared out.
+template <int kColumns>
+[[gnu::always_inline]] inline void dot_columns(long rows, const double* __restrict a,
+                                               const double* __restrict x, long j,
+                                               double* __restrict y) {
+  typedef double Lanes __attribute__((vector_size(32)));
+  const long body = rows - rows % 4;
+  Lanes s[kColumns];
+  for (int c = 0; c < kColumns; ++c) s[c] = Lanes{0.0, 0.0, 0.0, 0.0};
+  for (long i = 0; i < body; i += 4) {
+    Lanes v;
+    std::memcpy(&v, x + i, sizeof v);
+    for (int c = 0; c < kColumns; ++c) {
+      Lanes column;
+      std::memcpy(&column, a + (j + c) * rows + i, sizeof column);
+      s[c] += column * v;
     }
-    for (long i = body; i < rows; ++i)
-      for (int j = 0; j < kBlock; ++j)
-        for (int v = 0; v < kVectors; ++v) y[v * ldy + i] += p[v][j] * col[j * lda + i];
   }
-  for (; k < cols; ++k)
-    for (int v = 0; v < kVectors; ++v) {
-      const double p = x[v * cols + k];
-      for (long i = 0; i < rows; ++i) y[v * ldy + i] += p * a[k * lda + i];
-    }
+  for (int c = 0; c < kColumns; ++c) {
+    double lanes[4];
+    std::memcpy(lanes, &s[c], sizeof lanes);
+    double t = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+    for (long i = body; i < rows; ++i) t += a[(j + c) * rows + i] * x[i];
+    y[j + c] = t;
+  }
+}
+
+// t = a^T g and y = a x in one pass over a, x being written on the way: per chunk of kChunk
+// columns (whole blocks of 8; 64 columns of 1,038 rows are 530 kB, within a core's L2 cache),
+// their sums t, then fill(context, k, end) (x's rows k .. end - 1 from t's), then the chunk's
+// part of y while its columns are still in the cache.
+constexpr long kChunk = 64;
+
+template <int kVectors, int kLanes>
+[[gnu::always_inline]] inline void transposed_then(long rows, long cols, const double* a,
+                                                   const double* g, double* t, ProjectionFill fill,
+                                                   void* context, const double* x, double* y) {
+  zero<kVectors>(rows, y, rows);
+  const long whole = cols - cols % kBlock;
+  for (long k = 0; k < whole; k += kChunk) {
+    const long end = std::min(k + kChunk, whole);
+    for (long b = k; b < end; b += kBlock) dot_columns<kBlock>(rows, a, g, b, t);
+    fill(context, k, end);
+    for (long b = k; b < end; b += kBlock)
+      add_block<kVectors, kLanes>(rows, a + b * rows, rows, x, cols, b, y, rows);
+  }
+  if (whole == cols) return;
+  for (long k = whole; k < cols; ++k) dot_columns<1>(rows, a, g, k, t);
+  fill(context, whole, cols);
+  for (long k = whole; k < cols; ++k) add_column<kVectors>(rows, a, rows, x, cols, k, y, rows);
 }
 
 // Clones chosen by the instruction sets the CPU has, not by its model: a clone "arch=haswell" is
@@ -85,13 +161,34 @@ template <int kVectors, int kLanes = 8>
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && \
     !defined(BEAMRAIL_NO_MULTIVERSION)
 #define BEAMRAIL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#define BEAMRAIL_AVX512 __attribute__((target("avx512f")))
+bool has_avx512() {
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  return avx512;
+}
 #else
 #define BEAMRAIL_CLONES
+#define BEAMRAIL_AVX512
+bool has_avx512() { return false; }
 #endif
 
-BEAMRAIL_CLONES void pair_kernel(long rows, long cols, const double* a, long lda, const double* x,
-                                 double* y, long ldy) {
+// The pair in 8 lanes where the CPU has AVX-512 (one register, fused multiply-adds: 4 lanes there
+// are two AVX2 operations without them), 4 lanes else. Measured on an AVX-512 machine (AMD EPYC,
+// medians of 15 runs of 20, interleaved): n = 1,038 144 against 164 us, n = 600 49 against
+// 60 us.
+BEAMRAIL_AVX512 void pair_kernel_avx512(long rows, long cols, const double* a, long lda,
+                                        const double* x, double* y, long ldy) {
+  wide_kernel<2, 8>(rows, cols, a, lda, x, y, ldy);
+}
+
+BEAMRAIL_CLONES void pair_kernel_avx2(long rows, long cols, const double* a, long lda,
+                                      const double* x, double* y, long ldy) {
   wide_kernel<2, 4>(rows, cols, a, lda, x, y, ldy);
+}
+
+void pair_kernel(long rows, long cols, const double* a, long lda, const double* x, double* y,
+                 long ldy) {
+  (has_avx512() ? pair_kernel_avx512 : pair_kernel_avx2)(rows, cols, a, lda, x, y, ldy);
 }
 
 BEAMRAIL_CLONES void six_kernel(long rows, long cols, const double* a, long lda, const double* x,
@@ -104,49 +201,38 @@ BEAMRAIL_CLONES void vector_kernel(long rows, long cols, const double* a, long l
   wide_kernel<1, 4>(rows, cols, a, lda, x, y, ldy);
 }
 
-// y_j = sum_i a_ij x_i for the columns [begin, end) of the rows x cols matrix a (a^T x): eight
-// columns at a time against one load of x, each sum in 4-double vectors (one AVX2 register) over
-// the rows, the last rows % 4 added after. Each column is summed alone, so the bits do not depend
-// on how the columns are shared out. Measured on an AVX2 machine (AMD EPYC) against Eigen's
-// a.transpose() * x (SSE2 as this library is compiled): n = 1,038 164 against 201 us, n = 240
-// 8.2 against 11.5 us, 6,000 x 95 88 against 111 us.
+// a^T x for the columns [begin, end): eight at a time. Measured on an AVX2 machine (AMD EPYC)
+// against Eigen's a.transpose() * x (SSE2 as this library is compiled): n = 1,038 164 against
+// 201 us, n = 240 8.2 against 11.5 us, 6,000 x 95 88 against 111 us.
 BEAMRAIL_CLONES void transposed_kernel(long rows, long begin, long end, const double* a,
                                        const double* x, double* y) {
-  typedef double Lanes __attribute__((vector_size(32)));
-  constexpr int kColumns = 8;
-  const long body = rows - rows % 4;
-  const auto finish = [&](const Lanes& sum, long j) {
-    double lanes[4];
-    std::memcpy(lanes, &sum, sizeof lanes);
-    double t = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-    for (long i = body; i < rows; ++i) t += a[j * rows + i] * x[i];
-    y[j] = t;
-  };
   long j = begin;
-  for (; j + kColumns <= end; j += kColumns) {
-    Lanes s[kColumns];
-    for (int c = 0; c < kColumns; ++c) s[c] = Lanes{0.0, 0.0, 0.0, 0.0};
-    for (long i = 0; i < body; i += 4) {
-      Lanes v;
-      std::memcpy(&v, x + i, sizeof v);
-      for (int c = 0; c < kColumns; ++c) {
-        Lanes column;
-        std::memcpy(&column, a + (j + c) * rows + i, sizeof column);
-        s[c] += column * v;
-      }
-    }
-    for (int c = 0; c < kColumns; ++c) finish(s[c], j + c);
-  }
-  for (; j < end; ++j) {
-    Lanes s = {0.0, 0.0, 0.0, 0.0};
-    for (long i = 0; i < body; i += 4) {
-      Lanes v, column;
-      std::memcpy(&v, x + i, sizeof v);
-      std::memcpy(&column, a + j * rows + i, sizeof column);
-      s += column * v;
-    }
-    finish(s, j);
-  }
+  for (; j + kBlock <= end; j += kBlock) dot_columns<kBlock>(rows, a, x, j, y);
+  for (; j < end; ++j) dot_columns<1>(rows, a, x, j, y);
+}
+
+BEAMRAIL_AVX512 void transposed_then_pair_avx512(long rows, long cols, const double* a,
+                                                 const double* g, double* t, ProjectionFill fill,
+                                                 void* context, const double* x, double* y) {
+  transposed_then<2, 8>(rows, cols, a, g, t, fill, context, x, y);
+}
+
+BEAMRAIL_CLONES void transposed_then_pair_avx2(long rows, long cols, const double* a,
+                                               const double* g, double* t, ProjectionFill fill,
+                                               void* context, const double* x, double* y) {
+  transposed_then<2, 4>(rows, cols, a, g, t, fill, context, x, y);
+}
+
+void transposed_then_pair_kernel(long rows, long cols, const double* a, const double* g, double* t,
+                                 ProjectionFill fill, void* context, const double* x, double* y) {
+  (has_avx512() ? transposed_then_pair_avx512 : transposed_then_pair_avx2)(rows, cols, a, g, t,
+                                                                           fill, context, x, y);
+}
+
+BEAMRAIL_CLONES void transposed_then_six_kernel(long rows, long cols, const double* a,
+                                                const double* g, double* t, ProjectionFill fill,
+                                                void* context, const double* x, double* y) {
+  transposed_then<6, 8>(rows, cols, a, g, t, fill, context, x, y);
 }
 
 using Kernel = void (*)(long, long, const double*, long, const double*, double*, long);
@@ -193,12 +279,7 @@ bool three_pairs_in_one_pass() {
   // One pass where the six partial sums fit the registers (AVX-512); three pair passes else: on
   // an AVX2 machine (AMD EPYC, medians of 3 of tests/benchmarks/products_benchmark) one pass took
   // 827 us at n = 1,038 and three 690 us, 51 and 37 us at n = 240, 425 and 363 us at 6,000 x 95.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const bool one_pass = __builtin_cpu_supports("avx512f");
-  return one_pass;
-#else
-  return false;
-#endif
+  return has_avx512();
 }
 
 void multiply_three_pairs(const Eigen::MatrixXd& a, const double* x, double* y) {
@@ -232,6 +313,31 @@ void multiply_transposed(const Eigen::MatrixXd& a, const double* x, double* y) {
     if (end > begin) transposed_kernel(rows, begin, end, a.data(), x, y);
   }
 #endif
+}
+
+void multiply_transposed_then(const Eigen::MatrixXd& a, const double* g, double* t,
+                              ProjectionFill fill, void* context, int vectors, const double* x,
+                              double* y) {
+  const long rows = a.rows(), cols = a.cols();
+  if (threads_for(rows, cols, std::max(rows, cols)) > 1) {
+    // Threads share a^T g by columns and a x by rows: two passes, each shared.
+    multiply_transposed(a, g, t);
+    fill(context, 0, cols);
+    if (vectors == 2)
+      multiply_pair(a, x, y);
+    else
+      multiply_three_pairs(a, x, y);
+    return;
+  }
+  if (vectors == 2) {
+    transposed_then_pair_kernel(rows, cols, a.data(), g, t, fill, context, x, y);
+  } else if (three_pairs_in_one_pass()) {
+    transposed_then_six_kernel(rows, cols, a.data(), g, t, fill, context, x, y);
+  } else {
+    // Without AVX-512 the first pair on the way, the other two in pair passes.
+    transposed_then_pair_kernel(rows, cols, a.data(), g, t, fill, context, x, y);
+    for (int k = 1; k < 3; ++k) in_row_blocks(pair_kernel, a, x + 2 * cols * k, y + 2 * rows * k);
+  }
 }
 
 long products_on_threads() { return products_shared.load(); }

@@ -60,4 +60,19 @@ void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y);
 // y = a^T x for the vectors x (length a.rows()) and y (length a.cols()).
 void multiply_transposed(const Eigen::MatrixXd& a, const double* x, double* y);
 
+// Writes the rows [begin, end) of each column of a product's right-hand side x from the entries
+// [begin, end) of t = a^T g (multiply_transposed_then).
+using ProjectionFill = void (*)(void* context, long begin, long end);
+
+// t = a^T g (t: a.cols()), then y = a x for x (a.cols() x vectors, vectors 2 or 6) whose rows
+// fill writes from t's same rows: a change of basis whose result sets the next one mode by mode,
+// as a stage of the modal method projects its forcing and builds the next stage. On one thread
+// in one pass over a, in chunks of columns: their sums, their rows of x (fill, called in order,
+// once per row), their part of y while the chunk is in the cache; with threads two passes, each
+// shared. The results are those of multiply_transposed, then multiply_pair or
+// multiply_three_pairs, to the bit.
+void multiply_transposed_then(const Eigen::MatrixXd& a, const double* g, double* t,
+                              ProjectionFill fill, void* context, int vectors, const double* x,
+                              double* y);
+
 }  // namespace beamrail

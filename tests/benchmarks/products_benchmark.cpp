@@ -35,6 +35,26 @@ void Transposed(benchmark::State& state) {
   }
 }
 
+// t = a^T g, then y = a x with x from t mode by mode (multiply_transposed_then; kVectors 2 or 6):
+// a stage of the modal method, against Transposed and Pair (or ThreePairs) apart.
+void SetRows(void* context, long begin, long end) {
+  auto* x = static_cast<Eigen::MatrixXd*>(context);
+  for (long k = begin; k < end; ++k) x->row(k).setConstant(0.5 * k);
+}
+
+template <int kVectors>
+void TransposedThen(benchmark::State& state) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(state.range(0), state.range(1));
+  const Eigen::VectorXd g = Eigen::VectorXd::Random(a.rows());
+  Eigen::VectorXd t(a.cols());
+  Eigen::MatrixXd x(a.cols(), kVectors), y(a.rows(), kVectors);
+  const ProductThreads threads(static_cast<int>(state.range(2)));
+  for (auto _ : state) {
+    multiply_transposed_then(a, g.data(), t.data(), SetRows, &x, kVectors, x.data(), y.data());
+    benchmark::DoNotOptimize(y.data());
+  }
+}
+
 void Sizes(benchmark::internal::Benchmark* b) {
   for (auto [rows, cols] : {std::pair{240L, 240L}, {600L, 600L}, {1038L, 1038L}, {6000L, 95L}})
     for (long threads : {1L, 2L}) b->Args({rows, cols, threads});
@@ -44,6 +64,8 @@ void Sizes(benchmark::internal::Benchmark* b) {
 BENCHMARK(Columns<2, multiply_pair>)->Name("Pair")->Apply(Sizes);
 BENCHMARK(Columns<6, multiply_three_pairs>)->Name("ThreePairs")->Apply(Sizes);
 BENCHMARK(Transposed)->Apply(Sizes);
+BENCHMARK(TransposedThen<2>)->Name("TransposedThenPair")->Apply(Sizes);
+BENCHMARK(TransposedThen<6>)->Name("TransposedThenThreePairs")->Apply(Sizes);
 
 }  // namespace
 }  // namespace beamrail

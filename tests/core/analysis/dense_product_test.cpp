@@ -134,5 +134,70 @@ TEST(DenseProduct, ThreadsGiveTheSameBits) {
   EXPECT_EQ(product_threads(), 1);
 }
 
+// multiply_transposed_then: t = a^T g, then y = a x with x's rows made from t's (here x(k, v) =
+// (v + 1) t_k + c_kv, as a modal stage's state is its projected forcing times the modes'
+// coefficients plus what is known before), in one pass on one thread and in two shared passes
+// with threads: the same bits as multiply_transposed, then multiply_pair or multiply_three_pairs
+// given that x, at sizes around the blocking of 8, on a band's tall basis and the tower's square
+// one. The fill is asked for every row once, in order.
+struct Fill {
+  const double* t;
+  const Eigen::MatrixXd* c;
+  Eigen::MatrixXd* x;
+  long next = 0;  // the first row not yet filled
+  bool in_order = true;
+};
+
+void fill_rows(void* context, long begin, long end) {
+  Fill& f = *static_cast<Fill*>(context);
+  if (begin != f.next) f.in_order = false;
+  f.next = end;
+  for (long k = begin; k < end; ++k)
+    for (Eigen::Index v = 0; v < f.x->cols(); ++v) (*f.x)(k, v) = (v + 1.0) * f.t[k] + (*f.c)(k, v);
+}
+
+TEST(DenseProduct, TransposedThenProductGivesTheBitsOfTwoProducts) {
+  for (auto [rows, cols] : {std::pair{1, 1},
+                            {7, 9},
+                            {9, 7},
+                            {17, 17},
+                            {60, 60},
+                            {240, 240},
+                            {600, 95},
+                            {95, 600},
+                            {1038, 1038}})
+    for (int vectors : {2, 6})
+      for (int threads : {1, 2}) {
+        const std::string label = std::to_string(rows) + " x " + std::to_string(cols) + ", " +
+                                  std::to_string(vectors) + " vectors, " + std::to_string(threads) +
+                                  " threads";
+        const Eigen::MatrixXd a = Eigen::MatrixXd::Random(rows, cols);
+        const Eigen::VectorXd g = Eigen::VectorXd::Random(rows);
+        const Eigen::MatrixXd c = Eigen::MatrixXd::Random(cols, vectors);
+        const ProductThreads budget(threads);
+        Eigen::VectorXd t(cols);
+        Eigen::MatrixXd x(cols, vectors), y(rows, vectors);
+        Fill fill{t.data(), &c, &x};
+        multiply_transposed_then(a, g.data(), t.data(), fill_rows, &fill, vectors, x.data(),
+                                 y.data());
+        EXPECT_TRUE(fill.in_order && fill.next == cols) << label;
+        // The two products apart, and against Eigen.
+        Eigen::VectorXd t2(cols);
+        multiply_transposed(a, g.data(), t2.data());
+        Eigen::MatrixXd x2(cols, vectors), y2(rows, vectors);
+        Fill fill2{t2.data(), &c, &x2};
+        fill_rows(&fill2, 0, cols);
+        if (vectors == 2)
+          multiply_pair(a, x2.data(), y2.data());
+        else
+          multiply_three_pairs(a, x2.data(), y2.data());
+        EXPECT_TRUE(t == t2) << label << " (a^T g)";
+        EXPECT_TRUE(x == x2) << label << " (x)";
+        EXPECT_TRUE(y == y2) << label << " (a x)";
+        EXPECT_LT((t - a.transpose() * g).cwiseAbs().maxCoeff(), 1e-14 * rows) << label;
+        EXPECT_LT((y - a * x).cwiseAbs().maxCoeff(), 1e-14 * rows * cols) << label;
+      }
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -24,12 +24,22 @@ struct ModeFunction {
   bool empty() const { return alpha.size() == 0; }  // a zero coefficient: skipped
 };
 
-// out += s f(B) z, per mode (inline: every stage of every step calls it).
+// out += s f(B) z for the `count` modes from `begin` (inline: every stage of every step calls
+// it). Each mode's value is the same whatever the range it is computed in.
+inline void apply_add(const ModeFunction& f, const Eigen::ArrayXd& lambda, const ModeBlock& z,
+                      ModeBlock& out, double s, Eigen::Index begin, Eigen::Index count) {
+  const auto a = z.col(0).segment(begin, count).array();
+  const auto b = z.col(1).segment(begin, count).array();
+  const auto alpha = f.alpha.segment(begin, count), beta = f.beta.segment(begin, count);
+  out.col(0).segment(begin, count).array() += s * (alpha * a + beta * b);
+  out.col(1).segment(begin, count).array() +=
+      s * (alpha * b - beta * lambda.segment(begin, count) * a);
+}
+
+// out += s f(B) z for every mode.
 inline void apply_add(const ModeFunction& f, const Eigen::ArrayXd& lambda, const ModeBlock& z,
                       ModeBlock& out, double s = 1.0) {
-  const auto a = z.col(0).array(), b = z.col(1).array();
-  out.col(0).array() += s * (f.alpha * a + f.beta * b);
-  out.col(1).array() += s * (f.alpha * b - f.beta * lambda * a);
+  apply_add(f, lambda, z, out, s, 0, z.rows());
 }
 
 // The coefficient functions of one step of size h of the stiff-order-4 exponential Runge-Kutta

@@ -439,27 +439,118 @@ class ModalExponential : public Integrator {
     return true;
   }
 
-  // One step of size f.h from (t, z) into `out`; n0 = N(t, z) is given.
-  bool step(const StepFunctions& f, double t, const Block& z, const Block& n0, Block& out,
-            int* flag) {
-    constexpr int s = StepFunctions::kStages;
-    stage_n_[0] = n0;
-    for (int i = 1; i < s; ++i) {
-      stage_z_.setZero(m_, 2);
-      apply_add(StepFunctions::c[i] == 1.0 ? f.e_full : f.e_half, lambda_, z, stage_z_);
-      for (int j = 0; j < i; ++j) {
-        if (f.a[i][j].empty()) continue;
-        apply_add(f.a[i][j], lambda_, stage_n_[j], stage_z_, f.h);
-      }
-      multiply(phi_, stage_z_, xi_);
-      if (reduced_) xi_.col(0) += quasi_.y();
-      if (!nonlinear(t + StepFunctions::c[i] * f.h, stage_z_, xi_, stage_n_[i], flag)) return false;
+  // The accelerations at the physical state x and M0 a into m0_v_, for a projection that
+  // finishes N (every mode integrated: N = Phi^T M0 a + lambda z, project_then). False when the
+  // forces are not finite or a body turned too far.
+  bool evaluate(double t, const Block& x, int* flag) {
+    if (!states_of(x, y13_.data())) {
+      *flag = kTooFar;
+      return false;
     }
-    out.setZero(m_, 2);
-    apply_add(f.e_full, lambda_, z, out);
-    for (int j = 0; j < s; ++j)
-      if (!f.b[j].empty()) apply_add(f.b[j], lambda_, stage_n_[j], out, f.h);
+    if (!accelerations(t, x)) {
+      *flag = kNonFinite;
+      return false;
+    }
+    m0_v_.noalias() = m0_ * acceleration_;
     return true;
+  }
+
+  // One trial step of size f.h from the accepted state (t_, z_): the new state into next_, and
+  // with its two error distances into trial_ (modal) and trial_x_ (physical). N(t_, z_) is n0_
+  // when have_n0_; else its accelerations are in m0_v_ (evaluate). Every mode integrated, each
+  // stage's forcing is projected in the pass over Phi that makes the next stage's physical state
+  // (or the new state and its distances): multiply_transposed_then, one pass for two products
+  // and the same bits. Band-limited, the quasi-static iteration projects it on its own.
+  bool step(const StepFunctions& f, int* flag) {
+    constexpr int s = StepFunctions::kStages;
+    int pending = have_n0_ ? -1 : 0;  // the stage whose forcing awaits its projection
+    if (have_n0_) stage_n_[0] = n0_;
+    trial_.resize(m_, 6);
+    trial_x_.resize(n_, 6);
+    xi_.resize(n_, 2);
+    for (int i = 1; i <= s; ++i) {  // i == s: the new state
+      // What is known of stage i (or the new state) before the pending forcing, in the order of
+      // the method's sums (the pending stage is the last one summed).
+      Block& target = i < s ? stage_z_[i % 2] : next_;
+      target.setZero(m_, 2);
+      apply_add(i < s && StepFunctions::c[i] != 1.0 ? f.e_half : f.e_full, lambda_, z_, target);
+      for (int j = 0; j < i; ++j) {
+        const ModeFunction& weight = i < s ? f.a[i][j] : f.b[j];
+        if (j != pending && !weight.empty()) apply_add(weight, lambda_, stage_n_[j], target, f.h);
+      }
+      if (pending >= 0) {
+        project_then(i, i < s ? target.data() : trial_.data(), i < s ? 2 : 6,
+                     i < s ? xi_.data() : trial_x_.data());
+        if (pending == 0) {
+          n0_ = stage_n_[0];
+          have_n0_ = true;
+        }
+      } else if (i < s) {
+        multiply(phi_, target, xi_);
+      } else {
+        estimates(f, 0, m_);
+        multiply_three_pairs(phi_, trial_.data(), trial_x_.data());
+      }
+      if (i == s) break;
+      const double t = t_ + StepFunctions::c[i] * f.h;
+      if (reduced_) {
+        xi_.col(0) += quasi_.y();
+        if (!nonlinear(t, target, xi_, stage_n_[i], flag)) return false;
+      } else {
+        if (!evaluate(t, xi_, flag)) return false;
+        pending = i;
+      }
+    }
+    return true;
+  }
+
+  // The pass over Phi that projects stage `stage - 1`'s forcing (M0 a in m0_v_) and multiplies
+  // x (m x vectors, written on the way by fill) into y.
+  void project_then(int stage, double* x, int vectors, double* y) {
+    fill_stage_ = stage;
+    Block& n = stage_n_[stage - 1];
+    n.resize(m_, 2);
+    n.col(0).setZero();
+    multiply_transposed_then(phi_, m0_v_.data(), n.col(1).data(), fill_rows, this, vectors, x, y);
+  }
+
+  static void fill_rows(void* self, long begin, long end) {
+    static_cast<ModalExponential*>(self)->fill(begin, end - begin);
+  }
+
+  // The `count` modes from `begin` of the projected stage's N (Phi^T M0 a, written by the pass,
+  // + lambda z), then of what the pass multiplies: stage fill_stage_'s state, or at the step's
+  // end the new state and its distances.
+  void fill(Eigen::Index begin, Eigen::Index count) {
+    constexpr int s = StepFunctions::kStages;
+    const StepFunctions& f = full_;
+    const int j = fill_stage_ - 1;
+    Block& n = stage_n_[j];
+    const Block& zj = j == 0 ? z_ : stage_z_[j % 2];
+    n.col(1).segment(begin, count).array() +=
+        lambda_.segment(begin, count) * zj.col(0).segment(begin, count).array();
+    const ModeFunction& weight = fill_stage_ < s ? f.a[fill_stage_][j] : f.b[j];
+    Block& target = fill_stage_ < s ? stage_z_[fill_stage_ % 2] : next_;
+    if (!weight.empty()) apply_add(weight, lambda_, n, target, f.h, begin, count);
+    if (fill_stage_ == s) estimates(f, begin, count);
+  }
+
+  // The `count` modes from `begin` of the new state's two error distances (next_ holds the new
+  // state), and the three side by side into trial_: the distance to the embedded third-order
+  // solution, h b5 (N5 - N3), and to the embedded second-order one from stages 1 and 2.
+  void estimates(const StepFunctions& f, Eigen::Index begin, Eigen::Index count) {
+    third_.resize(m_, 2);
+    third_.middleRows(begin, count).setZero();
+    apply_add(f.b[4], lambda_, stage_n_[4], third_, f.h, begin, count);
+    apply_add(f.b[4], lambda_, stage_n_[2], third_, -f.h, begin, count);
+    second_.resize(m_, 2);
+    second_.middleRows(begin, count) = next_.middleRows(begin, count);
+    apply_add(f.e_full, lambda_, z_, second_, -1.0, begin, count);
+    apply_add(f.low[0], lambda_, stage_n_[0], second_, -f.h, begin, count);
+    apply_add(f.low[1], lambda_, stage_n_[1], second_, -f.h, begin, count);
+    trial_.block(begin, 0, count, 2) = next_.middleRows(begin, count);
+    trial_.block(begin, 2, count, 2) = third_.middleRows(begin, count);
+    trial_.block(begin, 4, count, 2) = second_.middleRows(begin, count);
   }
 
   // Weighted RMS norm of an error e = Phi dz in the physical states (x: rtol |c| + atol for
@@ -520,9 +611,13 @@ class ModalExponential : public Integrator {
     if (stats_.steps >= options_.max_steps) return kTooManySteps;
     int flag = kOk;
     try {
-      if (!have_n0_ && !nonlinear(t_, z_, x_, n0_, &flag)) return fail_flag(flag);
-      have_n0_ = true;
-      const Block& n0 = n0_;
+      if (!have_n0_) {
+        // Band-limited, N at the accepted state now; else its accelerations, projected in the
+        // step's first pass.
+        if (reduced_ ? !nonlinear(t_, z_, x_, n0_, &flag) : !evaluate(t_, x_, &flag))
+          return fail_flag(flag);
+        have_n0_ = reduced_;
+      }
       if (reduced_) quasi_.begin_step();  // the quasi-static part at the accepted state
       if (h_ <= 0.0) h_ = options_.initial_step > 0.0 ? options_.initial_step : (target - t_);
       for (int attempt = 0;; ++attempt) {
@@ -533,30 +628,12 @@ class ModalExponential : public Integrator {
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
         full_.compute(h, lambda_);
         if (reduced_) quasi_.restore();  // not a rejected trial's
-        Block& next = next_;
         int sflag = kOk;
-        const bool ok = step(full_, t_, z_, n0, next, &sflag);
+        const bool ok = step(full_, &sflag);
         double err = 0.0;
         if (ok) {
-          // The distance to the embedded third-order solution, h b5 (N5 - N3), and to the
-          // embedded second-order one from stages 1 and 2 against rtol^(3/4) (both then ask for
-          // steps ~ rtol^(1/4)); the new state and both distances go to physical states in one
-          // call (multiply_three_pairs: one pass over Phi with AVX-512, three without).
-          trial_.resize(m_, 6);
-          trial_.leftCols<2>() = next;
-          Block& difference = difference_;
-          difference.setZero(m_, 2);
-          apply_add(full_.b[4], lambda_, stage_n_[4], difference, h);
-          apply_add(full_.b[4], lambda_, stage_n_[2], difference, -h);
-          trial_.middleCols<2>(2) = difference;
-          // next - low, low the embedded second-order solution.
-          difference = next;
-          apply_add(full_.e_full, lambda_, z_, difference, -1.0);
-          apply_add(full_.low[0], lambda_, stage_n_[0], difference, -h);
-          apply_add(full_.low[1], lambda_, stage_n_[1], difference, -h);
-          trial_.rightCols<2>() = difference;
-          trial_x_.resize(n_, 6);
-          multiply_three_pairs(phi_, trial_.data(), trial_x_.data());
+          // The distances to the embedded third-order solution and to the embedded second-order
+          // one against rtol^(3/4) (both then ask for steps ~ rtol^(1/4)), as physical states.
           x_next_ = trial_x_.leftCols<2>();
           err = std::max(error_norm(trial_x_.middleCols<2>(2), x_next_) / kToleranceScale,
                          error_norm(trial_x_.rightCols<2>(), x_next_) * low_order_weight_);
@@ -576,7 +653,7 @@ class ModalExponential : public Integrator {
         }
         if (err <= 1.0) {
           t_ = (h == target - t_) ? target : t_ + h;
-          z_.swap(next);
+          z_.swap(next_);
           x_.swap(x_next_);
           if (reduced_) {
             x_.col(0) += quasi_.y();
@@ -656,8 +733,10 @@ class ModalExponential : public Integrator {
   Block xi_, x_next_;  // work space: a stage's physical state, a trial step's
   // A trial step's new state and its two error estimates side by side, modal and physical.
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
-  Block stage_z_, next_, difference_;  // work space: a stage's modal state, a trial step, errors
-  double inertia_limit_ = 0.0;         // set_inertia_limit
+  // Work space: the modal states of the last two stages, a trial step's new state, its distances.
+  Block stage_z_[2], next_, third_, second_;
+  int fill_stage_ = 0;             // the stage (kStages: the new state) whose pass is under way
+  double inertia_limit_ = 0.0;     // set_inertia_limit
   std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote
   Eigen::VectorXd acceleration_;   // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;

@@ -1,6 +1,7 @@
 // Products of a dense matrix with one, two or six vectors: the modal integrator's changes of basis,
-// ten to twenty per step on matrices up to 1200 x 1200 (every mode) or n x m (a band of m modes of
-// n degrees of freedom, 6000 x 95 and more).
+// five passes over the matrix per step (every mode: each a^T x with the a x that follows it) to
+// twenty (a band's quasi-static iteration), on matrices up to 1200 x 1200 (every mode) or n x m (a
+// band of m modes of n degrees of freedom, 6000 x 95 and more).
 //
 // Eigen's product of a dynamic matrix with an n x 2 block takes its matrix-matrix path, which
 // repacks the big factor on every call; as two matrix-vector products it is twice as fast, and

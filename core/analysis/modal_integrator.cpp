@@ -479,7 +479,7 @@ class ModalExponential : public Integrator {
         if (j != pending && !weight.empty()) apply_add(weight, lambda_, stage_n_[j], target, f.h);
       }
       if (pending >= 0) {
-        project_then(i, i < s ? target.data() : trial_.data(), i < s ? 2 : 6,
+        project_then(f, i, i < s ? target.data() : trial_.data(), i < s ? 2 : 6,
                      i < s ? xi_.data() : trial_x_.data());
         if (pending == 0) {
           n0_ = stage_n_[0];
@@ -505,8 +505,9 @@ class ModalExponential : public Integrator {
   }
 
   // The pass over Phi that projects stage `stage - 1`'s forcing (M0 a in m0_v_) and multiplies
-  // x (m x vectors, written on the way by fill) into y.
-  void project_then(int stage, double* x, int vectors, double* y) {
+  // x (m x vectors, written on the way by fill with the step's functions f) into y.
+  void project_then(const StepFunctions& f, int stage, double* x, int vectors, double* y) {
+    fill_functions_ = &f;
     fill_stage_ = stage;
     Block& n = stage_n_[stage - 1];
     n.resize(m_, 2);
@@ -523,7 +524,7 @@ class ModalExponential : public Integrator {
   // end the new state and its distances.
   void fill(Eigen::Index begin, Eigen::Index count) {
     constexpr int s = StepFunctions::kStages;
-    const StepFunctions& f = full_;
+    const StepFunctions& f = *fill_functions_;
     const int j = fill_stage_ - 1;
     Block& n = stage_n_[j];
     const Block& zj = j == 0 ? z_ : stage_z_[j % 2];
@@ -735,8 +736,9 @@ class ModalExponential : public Integrator {
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
   // Work space: the modal states of the last two stages, a trial step's new state, its distances.
   Block stage_z_[2], next_, third_, second_;
-  int fill_stage_ = 0;             // the stage (kStages: the new state) whose pass is under way
-  double inertia_limit_ = 0.0;     // set_inertia_limit
+  int fill_stage_ = 0;  // the stage (kStages: the new state) whose pass is under way, and
+  const StepFunctions* fill_functions_ = nullptr;  // the functions of its step
+  double inertia_limit_ = 0.0;                     // set_inertia_limit
   std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote
   Eigen::VectorXd acceleration_;   // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;

@@ -10,6 +10,7 @@
 #include "core/analysis/exponential_step.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/modal_band.hpp"
+#include "core/analysis/modal_coordinates.hpp"
 #include "core/analysis/modal_reference.hpp"
 #include "core/analysis/quasi_static_modes.hpp"
 #include "core/analysis/static_analysis.hpp"
@@ -23,7 +24,6 @@ namespace beamrail {
 namespace {
 
 constexpr int kD = kDofsPerBody;
-constexpr int kS = kStatesPerBody;
 
 using Block = ModeBlock;
 
@@ -80,16 +80,7 @@ class ModalExponential : public Integrator {
     set_state(model, data, reference.data());
     compute_wrenches(model, data, c.force_time(t0));
     compute_tangent(model, data, c.force_time(t0), false);
-    c0_.resize(model.n_free());
-    a0_.resize(model.n_free());
-    q0_.resize(model.n_free());
-    orientation_.resize(model.n_free());
-    for (int b = 0; b < model.n_free(); ++b) {
-      const double* r = reference.data() + kS * b;
-      c0_[b] = Vec3(r[0], r[1], r[2]);
-      q0_[b] = Vec4(r[3], r[4], r[5], r[6]).normalized();
-      a0_[b] = rotation_matrix<double>(q0_[b]);
-    }
+    coordinates_.set_reference(reference.data(), model.n_free());
     if (band_hz_ > 0.0 || o.choose_band) {
       if (!band_limited_basis(model, data, t0, y, error)) return false;
     } else {
@@ -172,12 +163,7 @@ class ModalExponential : public Integrator {
   double step_size() const { return h_; }
 
   // The largest rotation of a body from the linearization at the accepted state [rad].
-  double largest_rotation() const {
-    double largest = 0.0;
-    for (size_t b = 0; b < c0_.size(); ++b)
-      largest = std::max(largest, x_.block<3, 1>(kD * static_cast<Eigen::Index>(b) + 3, 0).norm());
-    return largest;
-  }
+  double largest_rotation() const { return coordinates_.largest_rotation(x_); }
 
   std::string failure(int flag) const override {
     if (context_->timed_out) return "timeout: the run exceeded its max_seconds budget";
@@ -224,9 +210,9 @@ class ModalExponential : public Integrator {
       // second-order parts, such as a bent beam's shortening, follow the bending instead).
       const Data linearized = data;
       Block x;
-      physical(y0, x);
+      coordinates_.offsets(y0, x);
       const Eigen::VectorXd velocity = x.col(1);
-      states_of(x, y13_.data(), false);  // with its velocities (gyroscopic forces, damping)
+      coordinates_.states(x, y13_.data());  // with its velocities (gyroscopic forces, damping)
       if (!accelerations(t0, x))
         return fail(error, "the modal integrator: the forces at the initial state are not finite");
       data = linearized;
@@ -277,11 +263,10 @@ class ModalExponential : public Integrator {
     const Eigen::VectorXd& dy = quasi_.correct(m0_a_, psi_a);
     x.col(0) += dy;
     double sum = 0.0;
-    for (size_t b = 0; b < c0_.size(); ++b)
+    for (int b = 0; b < coordinates_.bodies(); ++b)
       for (int j = 0; j < kD; ++j) {
         const Eigen::Index r = kD * static_cast<Eigen::Index>(b) + j;
-        const double w = j < 3 ? options_.rtol * std::abs(c0_[b](j) + x(r, 0)) + options_.atol
-                               : options_.rtol + options_.atol;
+        const double w = coordinates_.offset_weight(b, j, x, options_.rtol, options_.atol);
         sum += (dy(r) / w) * (dy(r) / w);
       }
     return std::sqrt(sum / static_cast<double>(n_));
@@ -304,7 +289,7 @@ class ModalExponential : public Integrator {
   // z from the 13 states of every free body.
   void from_states(const double* y) {
     Block x;
-    physical(y, x);
+    coordinates_.offsets(y, x);
     z_.resize(m_, 2);
     project(x.col(0), z_.col(0).data());
     project(x.col(1), z_.col(1).data());
@@ -316,56 +301,22 @@ class ModalExponential : public Integrator {
     }
   }
 
-  // The offsets from the linearization and their rates (x, u) of the 13 states of every body.
-  void physical(const double* y, Block& x) const {
-    x.resize(n_, 2);
-    for (size_t b = 0; b < c0_.size(); ++b) {
-      const double* s = y + kS * b;
-      const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
-      x.block<3, 1>(kD * b, 0) = Vec3(s[0], s[1], s[2]) - c0_[b];
-      x.block<3, 1>(kD * b + 3, 0) = rotation_vector(a * a0_[b].transpose());
-      x.block<3, 1>(kD * b, 1) = Vec3(s[7], s[8], s[9]);
-      x.block<3, 1>(kD * b + 3, 1) =
-          rotation_vector_rate(x.block<3, 1>(kD * b + 3, 0), a * Vec3(s[10], s[11], s[12]));
-    }
-  }
-
   // Physical coordinates x = Phi z into the 13 states; false (with far_body_ set) when a body
-  // turned too far and `check`; all bodies are written either way.
-  bool states_of(const Block& x, double* y, bool check = true) {
-    bool within = true;
-    for (size_t b = 0; b < c0_.size(); ++b) {
-      double* s = y + kS * b;
-      const Vec3 theta = x.block<3, 1>(kD * b + 3, 0);
-      if (check && within && !(theta.norm() <= max_rotation_)) {
-        far_body_ = static_cast<int>(b);
-        within = false;
-      }
-      Vec4 q = quat_multiply(quat_from_rotation_vector(theta), q0_[b]);
-      q /= q.norm();
-      const Mat3& a = orientation_[b] = rotation_matrix<double>(q);
-      const Vec3 c = c0_[b] + x.block<3, 1>(kD * b, 0);
-      const Vec3 w = a.transpose() * angular_velocity(theta, x.block<3, 1>(kD * b + 3, 1));
-      for (int j = 0; j < 3; ++j) {
-        s[j] = c(j);
-        s[7 + j] = x(kD * b + j, 1);
-        s[10 + j] = w(j);
-      }
-      for (int j = 0; j < 4; ++j) s[3 + j] = q(j);
-    }
-    return within;
+  // turned too far.
+  bool states_of(const Block& x, double* y) {
+    return coordinates_.states(x, y, max_rotation_, &far_body_);
   }
 
   // The accepted state (a rotation past the limit is reported by the next step that uses it),
   // with the quasi-static part's rate in the velocities when known.
   void to_states(double* y) {
     if (!(reduced_ && quasi_.rate_known())) {
-      states_of(x_, y, false);
+      coordinates_.states(x_, y);
       return;
     }
     Block x = x_;
     x.col(1) += quasi_.rate();
-    states_of(x, y, false);
+    coordinates_.states(x, y);
   }
 
   // The accelerations (dv/dt, d^2 theta/dt^2) into acceleration_ at the physical state x whose
@@ -374,17 +325,7 @@ class ModalExponential : public Integrator {
     state_derivative(context_->model, context_->data, context_->force_time(t), y13_.data(),
                      ydot13_.data());
     ++stats_.rhs_evaluations;
-    for (size_t b = 0; b < c0_.size(); ++b) {
-      const double* d = ydot13_.data() + kS * b;
-      for (int j = 0; j < kS; ++j)
-        if (!std::isfinite(d[j])) return false;
-      const Mat3& a = orientation_[b];  // of the quaternion in y13_
-      acceleration_.segment<3>(kD * b) = Vec3(d[7], d[8], d[9]);
-      acceleration_.segment<3>(kD * b + 3) =
-          rotation_vector_acceleration(x.block<3, 1>(kD * b + 3, 0), x.block<3, 1>(kD * b + 3, 1),
-                                       a * Vec3(d[10], d[11], d[12]));
-    }
-    return true;
+    return coordinates_.accelerations(x, ydot13_.data(), acceleration_);
   }
 
   // N(t, z): everything but the modes' linear part, in modal coordinates; x = Phi z is given.
@@ -558,11 +499,10 @@ class ModalExponential : public Integrator {
   // positions, rtol + atol for rotations; u: rtol |u| + atol) at the physical state x.
   double error_norm(const Eigen::Ref<const Block>& e, const Block& x) {
     double sum = 0.0;
-    for (size_t b = 0; b < c0_.size(); ++b)
+    for (int b = 0; b < coordinates_.bodies(); ++b)
       for (int j = 0; j < kD; ++j) {
         const Eigen::Index r = kD * static_cast<Eigen::Index>(b) + j;
-        const double wx = j < 3 ? options_.rtol * std::abs(c0_[b](j) + x(r, 0)) + options_.atol
-                                : options_.rtol + options_.atol;
+        const double wx = coordinates_.offset_weight(b, j, x, options_.rtol, options_.atol);
         const double wu = options_.rtol * std::abs(x(r, 1)) + options_.atol;
         sum += (e(r, 0) / wx) * (e(r, 0) / wx) + (e(r, 1) / wu) * (e(r, 1) / wu);
       }
@@ -727,11 +667,9 @@ class ModalExponential : public Integrator {
   Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
   Eigen::VectorXd m0_v_;          // work space of project
   Eigen::ArrayXd lambda_;
-  std::vector<Vec3> c0_;
-  std::vector<Vec4> q0_;
-  std::vector<Mat3> a0_;
-  Block z_, x_;        // the accepted state, modal and physical (x_ = Phi z_)
-  Block xi_, x_next_;  // work space: a stage's physical state, a trial step's
+  ModalCoordinates coordinates_;  // the bodies' offsets from the linearization and back
+  Block z_, x_;                   // the accepted state, modal and physical (x_ = Phi z_)
+  Block xi_, x_next_;             // work space: a stage's physical state, a trial step's
   // A trial step's new state and its two error estimates side by side, modal and physical.
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
   // Work space: the modal states of the last two stages, a trial step's new state, its distances.
@@ -739,8 +677,7 @@ class ModalExponential : public Integrator {
   int fill_stage_ = 0;  // the stage (kStages: the new state) whose pass is under way, and
   const StepFunctions* fill_functions_ = nullptr;  // the functions of its step
   double inertia_limit_ = 0.0;                     // set_inertia_limit
-  std::vector<Mat3> orientation_;  // the rotation matrices of the 13 states states_of last wrote
-  Eigen::VectorXd acceleration_;   // work space: the physical accelerations of a stage
+  Eigen::VectorXd acceleration_;  // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;
   double t0_ = 0.0;  // where the run started
   StepFunctions full_;

@@ -23,8 +23,10 @@
 // Cost: one dense eigenproblem (n_dofs^3) at set-up, then per stage one dense product with two
 // columns (x, u = Phi (eta, nu); core/analysis/dense_product) and one transposed product with
 // one (Phi^T (M0 a), M0 a 6 x 6 block per body: Phi is the one dense matrix stored, and a stored
-// M0 Phi beside it made the braced tower's every-mode run 26 % slower per step); hence a size
-// limit. The products use the threads of the caller's budget (ProductThreads,
+// M0 Phi beside it made the braced tower's every-mode run 26 % slower per step); with every mode
+// integrated, each stage's transposed product shares its pass over Phi with the next product
+// (five passes a step); hence a size limit. The bodies' coordinates and the way back to the
+// model's states: core/analysis/modal_coordinates.hpp. The products use the threads of the caller's budget (ProductThreads,
 // core/analysis/dense_product.hpp): the tower's 1 s run took 14.3 s on 2 threads, 15.8 s on 1
 // (AVX2 kernels; README "Why this machine ran the tower slower").
 // Accuracy degrades with the size of the motion: past kMaxRotation the run stops with a message

@@ -26,7 +26,8 @@
 // M0 Phi beside it made the braced tower's every-mode run 26 % slower per step); with every mode
 // integrated, each stage's transposed product shares its pass over Phi with the next product
 // (five passes a step); hence a size limit. The bodies' coordinates and the way back to the
-// model's states: core/analysis/modal_coordinates.hpp. The products use the threads of the caller's budget (ProductThreads,
+// model's states: core/analysis/modal_coordinates.hpp.
+// The products use the threads of the caller's budget (ProductThreads,
 // core/analysis/dense_product.hpp): the tower's 1 s run took 14.3 s on 2 threads, 15.8 s on 1
 // (AVX2 kernels; README "Why this machine ran the tower slower").
 // Accuracy degrades with the size of the motion: past kMaxRotation the run stops with a message

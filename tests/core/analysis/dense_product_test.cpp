@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <utility>
 
@@ -197,6 +198,22 @@ TEST(DenseProduct, TransposedThenProductGivesTheBitsOfTwoProducts) {
         EXPECT_LT((t - a.transpose() * g).cwiseAbs().maxCoeff(), 1e-14 * rows) << label;
         EXPECT_LT((y - a * x).cwiseAbs().maxCoeff(), 1e-14 * rows * cols) << label;
       }
+}
+
+// Without BEAMRAIL_PRODUCTS_WITHOUT_AVX512 the three pairs take one pass where the CPU has
+// AVX-512; with it (the test dense_product_test.KernelsWithoutAvx512 of tests/CMakeLists.txt runs
+// this program so) three pair passes with the pair in 4 lanes, as on a machine without AVX-512.
+TEST(DenseProduct, TheEnvironmentTakesTheKernelsWithoutAvx512) {
+  const bool without = std::getenv("BEAMRAIL_PRODUCTS_WITHOUT_AVX512") != nullptr;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && \
+    !defined(BEAMRAIL_NO_MULTIVERSION)
+  const bool avx512 = __builtin_cpu_supports("avx512f");
+#else
+  const bool avx512 = false;
+#endif
+  std::printf("AVX-512 %s, kernels %s\n", avx512 ? "present" : "absent",
+              three_pairs_in_one_pass() ? "with it" : "without it");
+  EXPECT_EQ(three_pairs_in_one_pass(), avx512 && !without);
 }
 
 }  // namespace

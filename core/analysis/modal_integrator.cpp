@@ -328,28 +328,19 @@ class ModalExponential : public Integrator {
     return coordinates_.accelerations(x, ydot13_.data(), acceleration_);
   }
 
-  // N(t, z): everything but the modes' linear part, in modal coordinates; x = Phi z is given.
-  // False when the forces are not finite or a body turned too far.
+  // N(t, z) of a band-limited run: everything but the modes' linear part, in modal coordinates,
+  // with the quasi-static part iterated into x (x = Phi z + y is given). Every mode integrated,
+  // step() projects N in its passes instead. False when the forces are not finite or a body
+  // turned too far.
   bool nonlinear(double t, const Block& z, Block& x, Block& out, int* flag) {
     out.resize(m_, 2);
     out.col(0).setZero();
     double last_size = 0.0;
     bool updated_here = false;
     for (int iteration = 0;; ++iteration) {
-      if (!states_of(x, y13_.data())) {
-        *flag = kTooFar;
-        return false;
-      }
-      if (!accelerations(t, x)) {
-        *flag = kNonFinite;
-        return false;
-      }
-      if (!reduced_) {
-        project(acceleration_, out.col(1).data());
-        break;
-      }
+      if (!evaluate(t, x, flag)) return false;
       psi_a_.resize(m_);
-      project(acceleration_, psi_a_.data());
+      multiply_transposed(phi_, m0_v_.data(), psi_a_.data());  // Phi^T M0 a
       // Quasi-static outside the band: corrected until the correction is a small part of the
       // tolerance (the accelerations of the last evaluation are kept).
       const double size = correct(psi_a_, x);

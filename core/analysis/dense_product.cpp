@@ -45,7 +45,11 @@ int threads_for(long rows, long cols, long parts) {
 // AVX2 machine (AMD EPYC) a pair with 4 lanes 230 us, with those plain loops 350 us, one vector
 // 179 against 183 us (and 78 against 83 us at 6,000 x 95, 6.3 against 8.5 us at n = 240). Every
 // entry of y is summed over the columns in their order whatever the blocking, so a pass that
-// computes x on its way (transposed_then) gives the bits of one that is given it.
+// computes x on its way (transposed_then) gives the bits of one that is given it. Other shapes
+// of the pair on the AVX-512 machine (a standalone copy, medians of 15): two partial sums per
+// vector, 16 columns per block, 16 rows per step took 7.1 to 9.1 us against 7.2 at n = 240 (in
+// L2) and 153 to 157 against 162 us at n = 1,040: about 16 and 14 GFMA/s, near what its FMA
+// units give at the 2.4 to 3.4 GHz this machine runs at. Kept as it is.
 constexpr int kBlock = 8;
 
 template <int kVectors>
@@ -134,7 +138,10 @@ template <int kColumns>
 // t = a^T g and y = a x in one pass over a, x being written on the way: per chunk of kChunk
 // columns (whole blocks of 8; 64 columns of 1,038 rows are 530 kB, within a core's L2 cache),
 // their sums t, then fill(context, k, end) (x's rows k .. end - 1 from t's), then the chunk's
-// part of y while its columns are still in the cache.
+// part of y while its columns are still in the cache. The sums read the chunk from L3 (a^T g
+// alone 102 us at n = 1,040, the pair 156, one pass 246), but prefetching the next chunk into L2
+// during this one's part of y (one prefetch per line read) made the pass slower: 336 to 348
+// against 276 us (a standalone copy, chunks of 16 to 64, medians of 15).
 constexpr long kChunk = 64;
 
 template <int kVectors, int kLanes>

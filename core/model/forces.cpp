@@ -36,6 +36,15 @@ void add_load_stiffness(const Model& model, Data& data, double t, double load_fa
 
 bool is_conservative(const Load& load) { return load.kind == LoadKind::kForce && !load.follows; }
 
+bool conserves_energy(const Model& model) {
+  if (!model.loads.empty() || !model.driven_bodies.empty()) return false;
+  for (const Beam& b : model.beams)
+    if (b.damping != 0.0 || b.formulation != Formulation::kEnergy) return false;
+  for (const Rail& r : model.rails)
+    if (r.damping != 0.0 || r.formulation != Formulation::kEnergy) return false;
+  return true;
+}
+
 namespace {
 
 // Scatters an element's 12 x 12 derivative into the four pattern blocks of its ends.

@@ -35,6 +35,11 @@ void add_load_stiffness(const Model& model, Data& data, double t, double load_fa
 // follower load have none (their work depends on the path) and make the tangent non-symmetric.
 bool is_conservative(const Load& load);
 
+// Whether the motion keeps its energy (kinetic + elastic + gravity): no loads, no driven bodies,
+// and every beam and rail undamped and under the energy law (docs/model.md "Two force laws": the
+// paper's end wrenches are not a gradient). Joints are penalty elements with a strain energy.
+bool conserves_energy(const Model& model);
+
 // Kinetic energy of all free bodies [J].
 double kinetic_energy(const Model& model, const Data& data);
 

@@ -24,6 +24,22 @@ void Trajectory::record(const TransientSample& sample, const Data& data) {
 
 namespace {
 
+// The largest distance of a value from the same body's first (values: time-major, nb per time);
+// NaN when one is not finite.
+template <class Value, class Distance>
+double largest_from_start(const std::vector<Value>& values, size_t nb, Distance distance) {
+  double largest = 0.0;
+  for (size_t k = 0; nb > 0 && k < values.size() / nb; ++k)
+    for (size_t b = 0; b < nb; ++b) {
+      const double d = distance(values[b], values[k * nb + b]);
+      if (!std::isfinite(d)) return std::numeric_limits<double>::quiet_NaN();
+      largest = std::max(largest, d);
+    }
+  return largest;
+}
+
+double centre_distance(const Vec3& a, const Vec3& b) { return (a - b).norm(); }
+
 // The largest distance between the runs' values of a body over the common samples, relative to
 // the largest distance of a reference value from the body's first (values: time-major, one per
 // body); NaN when nothing can be compared, a distance is not finite, or the reference moves no
@@ -37,17 +53,15 @@ double relative_error(const Trajectory& run, const Trajectory& reference,
   if (samples == 0 || nb == 0 || run.bodies.size() != nb ||
       run_values.size() != run.times.size() * nb || values.size() != reference.times.size() * nb)
     return std::numeric_limits<double>::quiet_NaN();
-  double error = 0.0, motion = 0.0;
-  bool finite = true;
-  const auto widen = [&finite](double& largest, double d) {
-    finite = finite && std::isfinite(d);
-    largest = std::max(largest, d);
-  };
-  for (size_t k = 0; k < reference.times.size(); ++k)
-    for (size_t b = 0; b < nb; ++b) widen(motion, distance(values[b], values[k * nb + b]));
+  const double motion = largest_from_start(values, nb, distance);
+  bool finite = std::isfinite(motion);
+  double error = 0.0;
   for (size_t k = 0; k < samples; ++k)
-    for (size_t b = 0; b < nb; ++b)
-      widen(error, distance(run_values[k * nb + b], values[k * nb + b]));
+    for (size_t b = 0; b < nb; ++b) {
+      const double d = distance(run_values[k * nb + b], values[k * nb + b]);
+      finite = finite && std::isfinite(d);
+      error = std::max(error, d);
+    }
   if (!finite || !(motion > least)) return std::numeric_limits<double>::quiet_NaN();
   return error / motion;
 }
@@ -55,14 +69,21 @@ double relative_error(const Trajectory& run, const Trajectory& reference,
 }  // namespace
 
 double trajectory_error(const Trajectory& run, const Trajectory& reference) {
-  return relative_error(
-      run, reference, run.positions, reference.positions,
-      [](const Vec3& a, const Vec3& b) { return (a - b).norm(); }, kLeastMotion);
+  return relative_error(run, reference, run.positions, reference.positions, centre_distance,
+                        kLeastMotion);
 }
 
 double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference) {
   return relative_error(run, reference, run.orientations, reference.orientations,
                         rotation_angle_between, kLeastTurn);
+}
+
+double largest_motion(const Trajectory& t) {
+  return largest_from_start(t.positions, t.bodies.size(), centre_distance);
+}
+
+double largest_turn(const Trajectory& t) {
+  return largest_from_start(t.orientations, t.bodies.size(), rotation_angle_between);
 }
 
 }  // namespace beamrail

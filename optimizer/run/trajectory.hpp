@@ -35,4 +35,9 @@ double trajectory_error(const Trajectory& run, const Trajectory& reference);
 inline constexpr double kLeastTurn = 1e-9;  // [rad]
 double trajectory_rotation_error(const Trajectory& run, const Trajectory& reference);
 
+// The largest distance a body's centre moved from its start [m], and the largest angle a body
+// turned from its start [rad; the angle of the relative rotation, at most pi], over the samples.
+double largest_motion(const Trajectory& t);
+double largest_turn(const Trajectory& t);
+
 }  // namespace beamrail

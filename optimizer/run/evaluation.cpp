@@ -425,9 +425,9 @@ class Runner {
   // radians, x the largest turn (every method weights a rotation absolutely, about rtol radians
   // per step: a carriage tilting 3.7e-4 rad on a rail was 4.8e-8 rad off at rtol 1e-6, 129 rtol of
   // its turn): the run is not within its tolerance and warns. The orientations only while no
-  // body turned past 3 rad: the measure is relative to the
-  // largest turn, at most pi, so a long spin's phase (the tumbling pair's 27 rad: about 3 rtol per
-  // radian turned) would read as tens of rtol whatever rtol; the centres still count there.
+  // body turned past 3 rad: the measure is relative to the largest turn, at most pi, so a long
+  // spin's phase (the tumbling pair's 27 rad: about 3 rtol per radian turned) would read as tens
+  // of rtol whatever rtol; the centres still count there.
   void warn_of_verification(const AnalysisSpec& spec, const TransientOptions& options,
                             const Verification& v, double motion, double turn) {
     const double rtol = options.integrator.rtol, atol = options.integrator.atol;

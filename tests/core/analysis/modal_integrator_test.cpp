@@ -342,10 +342,14 @@ TEST(ModalIntegrator, RefusesScenesAboveItsSizeLimit) {
 }
 
 TEST(ModalIntegrator, StopsWithAMessageWhenABodyTurnsTooFar) {
-  // A free body spinning at 2.2 rad/s about z passes 1 rad after 0.45 s.
+  // A body spinning at 2.2 rad/s about z on a revolute joint to the ground at its centre passes
+  // 1 rad after 0.45 s (a free one floats: the method follows it in a turning frame,
+  // turning_frame_test.cpp).
   const Model model = scene_from_json(R"({
     "bodies": [{"name": "spinner", "position": [0, 0, 0], "mass": 1.0,
-                "inertia": [0.1, 0.1, 0.2], "angular_velocity": [0, 0, 2.2]}]})");
+                "inertia": [0.1, 0.1, 0.2], "angular_velocity": [0, 0, 2.2]}],
+    "joints": [{"name": "pin", "type": "revolute", "body1": "ground", "body2": "spinner",
+                "point": [0, 0, 0], "axis": [0, 0, 1]}]})");
   const TransientRun run = simulate(model, modal(1.0, 0.1, 1e-8, 1e-10));
   EXPECT_FALSE(run.result.ok);
   EXPECT_NE(run.result.message.find("\"spinner\" turned more than"), std::string::npos)

@@ -519,7 +519,8 @@ class ModalExponential : public Integrator {
   // second-order one sees that. Measured against tight explicit runs over rtol 1e-4 .. 1e-9
   // (transient_auto_test.cpp, ErrorFollowsTheTolerance, auto): 0.011 .. 0.060 rtol on the
   // reference cantilever in 10 segments, 0.017 .. 1.3 on that torsion case, 0.13 .. 1.9 on the
-  // tumbling pair (relinearized); the second-order estimate alone gave 1e-2 .. 1e-5 rtol there.
+  // tumbling pair (relinearized, in fixed axes: since followed in a turning frame, 0.02 .. 0.13);
+  // the second-order estimate alone gave 1e-2 .. 1e-5 rtol there.
   // Where it costs: the braced tower of the README (1,038 dof, 2 kN step, rtol 1e-6, atol 1e-9,
   // 0.2 s) takes 797 steps held by the second-order estimate, almost all of it in the angular
   // velocities (atol-weighted: they are near zero), and leaves 0.03 rtol. The forcing there is

@@ -176,8 +176,7 @@ class AutoIntegrator : public Integrator {
       limit_inertia(*next);
       current_ = std::move(next);
       record(*t, "modal",
-             "body " + who + " turned " + number(turned) +
-                 " rad from the linearization" +
+             "body " + who + " turned " + number(turned) + " rad from the linearization" +
                  (modal_frame_rate(*current_) > 0.0 ? " (in the frame turning with the scene)"
                                                     : std::string()) +
                  ": relinearized about this state" +

@@ -11,8 +11,6 @@ namespace beamrail {
 namespace {
 constexpr int kD = kDofsPerBody;
 constexpr int kS = kStatesPerBody;
-
-Mat3 skew_square(const Vec3& w) { return w * w.transpose() - w.squaredNorm() * Mat3::Identity(); }
 }  // namespace
 
 bool floats(const Model& model) {
@@ -46,7 +44,7 @@ RigidMotion rigid_motion(const Model& model, const double* y) {
     const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
     const Vec3 r = Vec3(s[0], s[1], s[2]) - out.centre;
     const Mat3 own = a * body.inertia * a.transpose();
-    inertia += own - body.mass * skew_square(r);
+    inertia += own - body.mass * skew<double>(r) * skew<double>(r);
     momentum += body.mass * r.cross(Vec3(s[7], s[8], s[9]) - out.velocity) +
                 own * (a * Vec3(s[10], s[11], s[12]));
   }

@@ -96,13 +96,12 @@ TEST(TurningFrame, CoordinatesGoBothWaysAndARigidTurnWithTheFrameIsNoOffset) {
   std::vector<double> turned = y0;
   for (int i = 0; i < model.n_free(); ++i) {
     double* s = turned.data() + kStatesPerBody * i;
-    const Vec3 p = Vec3(y0[kStatesPerBody * i], y0[kStatesPerBody * i + 1],
-                        y0[kStatesPerBody * i + 2]) -
-                   motion.centre;
+    const Vec3 p =
+        Vec3(y0[kStatesPerBody * i], y0[kStatesPerBody * i + 1], y0[kStatesPerBody * i + 2]) -
+        motion.centre;
     const Vec3 c = motion.centre + motion.velocity * dt + r * p;
     const Vec3 v = motion.velocity + w.cross(r * p);
-    const Vec4 q = quat_multiply(quat_from_rotation_vector(w * dt),
-                                 Vec4(s[3], s[4], s[5], s[6]));
+    const Vec4 q = quat_multiply(quat_from_rotation_vector(w * dt), Vec4(s[3], s[4], s[5], s[6]));
     const Mat3 a = rotation_matrix<double>(q);
     const Vec3 body_w = a.transpose() * w;
     for (int j = 0; j < 3; ++j) {

@@ -95,8 +95,8 @@ class AutoIntegrator : public Integrator {
       reason += "; its damping allows steps up to " + number(step) + " s";
     }
     if (const double rate = modal_frame_rate(*modal); rate > 0.0)
-      reason += "; the scene floats and spins: followed in a frame turning with it at " +
-                number(rate) + " rad/s";
+      reason += "; floating and spinning: followed in a frame turning with it (" + number(rate) +
+                " rad/s, the fastest part)";
     if (const std::string band = modal_band_choice(*modal); !band.empty()) reason += "; " + band;
     for (const std::string& w : modal->warnings) warnings.push_back(w);
     const bool about_initial = o.about == "initial" || !modal->warnings.empty();
@@ -177,7 +177,7 @@ class AutoIntegrator : public Integrator {
       current_ = std::move(next);
       record(*t, "modal",
              "body " + who + " turned " + number(turned) + " rad from the linearization" +
-                 (modal_frame_rate(*current_) > 0.0 ? " (in the frame turning with the scene)"
+                 (modal_frame_rate(*current_) > 0.0 ? " (in the frame turning with its part)"
                                                     : std::string()) +
                  ": relinearized about this state" +
                  (choose_band_ ? "; " + modal_band_choice(*current_) : std::string()));

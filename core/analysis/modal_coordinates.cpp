@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <numeric>
 
 #include "core/model/element_kinds.hpp"
 #include "core/model/rotation.hpp"
@@ -13,20 +14,42 @@ constexpr int kD = kDofsPerBody;
 constexpr int kS = kStatesPerBody;
 }  // namespace
 
-bool floats(const Model& model) {
-  if (model.free_bodies.empty() || !model.driven_bodies.empty()) return false;
-  bool grounded = false;
+std::vector<std::vector<int>> floating_parts(const Model& model) {
+  if (!model.driven_bodies.empty()) return {};
+  const int n = static_cast<int>(model.bodies.size());
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::vector<char> grounded(n, 0);
+  for (int i = 0; i < n; ++i) grounded[i] = model.bodies[i].fixed ? 1 : 0;
   for_each_element(model, [&](auto kind, const auto& e, int) {
     using Kind = decltype(kind);
-    grounded = grounded || model.bodies[Kind::body1(e)].fixed || model.bodies[Kind::body2(e)].fixed;
+    const int a = root(Kind::body1(e)), b = root(Kind::body2(e));
+    if (a == b) return;
+    parent[a] = b;
+    grounded[b] = grounded[b] || grounded[a];
   });
-  return !grounded;
+  std::vector<std::vector<int>> parts;
+  std::vector<int> part_of(n, -1);
+  for (int i = 0; i < model.n_free(); ++i) {
+    const int r = root(model.free_bodies[i]);
+    if (grounded[r]) continue;
+    if (part_of[r] < 0) {
+      part_of[r] = static_cast<int>(parts.size());
+      parts.emplace_back();
+    }
+    parts[part_of[r]].push_back(i);
+  }
+  return parts;
 }
 
-RigidMotion rigid_motion(const Model& model, const double* y) {
+RigidMotion rigid_motion(const Model& model, const double* y, const std::vector<int>& part) {
   RigidMotion out;
   double mass = 0.0;
-  for (int i = 0; i < model.n_free(); ++i) {
+  for (int i : part) {
     const double m = model.bodies[model.free_bodies[i]].mass;
     const double* s = y + kS * i;
     mass += m;
@@ -38,7 +61,7 @@ RigidMotion rigid_motion(const Model& model, const double* y) {
   out.velocity /= mass;
   Mat3 inertia = Mat3::Zero();
   Vec3 momentum = Vec3::Zero();
-  for (int i = 0; i < model.n_free(); ++i) {
+  for (int i : part) {
     const Body& body = model.bodies[model.free_bodies[i]];
     const double* s = y + kS * i;
     const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
@@ -63,6 +86,8 @@ void ModalCoordinates::set_reference(const double* states, int bodies) {
   q0_.resize(bodies);
   a0_.resize(bodies);
   orientation_.resize(bodies);
+  frames_.clear();
+  frame_of_.assign(bodies, -1);
   for (int b = 0; b < bodies; ++b) {
     const double* r = states + kS * b;
     c0_[b] = Vec3(r[0], r[1], r[2]);
@@ -71,38 +96,46 @@ void ModalCoordinates::set_reference(const double* states, int bodies) {
   }
 }
 
-void ModalCoordinates::set_turning_frame(double t0, const RigidMotion& motion) {
-  turning_ = true;
-  t0_ = t0;
-  s0_ = motion.centre;
-  velocity_ = motion.velocity;
-  omega_ = motion.angular_velocity;
+void ModalCoordinates::set_turning_frame(double t0, const RigidMotion& motion,
+                                         const std::vector<int>& part) {
+  Frame f;
+  f.t0 = t0;
+  f.s0 = motion.centre;
+  f.velocity = motion.velocity;
+  f.omega = motion.angular_velocity;
+  for (int b : part) frame_of_[b] = static_cast<int>(frames_.size());
+  frames_.push_back(f);
 }
 
-Vec4 ModalCoordinates::frame_quaternion(double t) const {
-  return quat_from_rotation_vector(omega_ * (t - t0_));
+double ModalCoordinates::fastest_frame_rate() const {
+  double fastest = 0.0;
+  for (const Frame& f : frames_) fastest = std::max(fastest, f.omega.norm());
+  return fastest;
 }
 
-Mat3 ModalCoordinates::frame_rotation(double t) const {
-  return rotation_matrix<double>(frame_quaternion(t));
+void ModalCoordinates::Frame::at(double t) {
+  q = quat_from_rotation_vector(omega * (t - t0));
+  rotation = rotation_matrix<double>(q);
 }
 
 void ModalCoordinates::offsets(double t, const double* y, ModeBlock& x) const {
   x.resize(kD * static_cast<Eigen::Index>(c0_.size()), 2);
-  const Mat3 rt = turning_ ? Mat3(frame_rotation(t).transpose()) : Mat3::Identity();
-  const Vec3 s = s0_ + velocity_ * (t - t0_);
+  std::vector<Frame> frames = frames_;
+  for (Frame& f : frames) f.at(t);
   for (size_t b = 0; b < c0_.size(); ++b) {
     const double* y13 = y + kS * b;
     Mat3 a = rotation_matrix<double>(Vec4(y13[3], y13[4], y13[5], y13[6]));
     Vec3 c(y13[0], y13[1], y13[2]), v(y13[7], y13[8], y13[9]);
     Vec3 w = a * Vec3(y13[10], y13[11], y13[12]);  // global
-    if (turning_) {
+    if (frame_of_[b] >= 0) {
       // In the frame: p = R^T (c - s), v = R^T (v - V) - W x p, A = R^T A, w = R^T w - W.
-      const Vec3 p = rt * (c - s);
-      c = s0_ + p;
-      v = rt * (v - velocity_) - omega_.cross(p);
+      const Frame& f = frames[frame_of_[b]];
+      const Mat3 rt = f.rotation.transpose();
+      const Vec3 p = rt * (c - f.s0 - f.velocity * (t - f.t0));
+      c = f.s0 + p;
+      v = rt * (v - f.velocity) - f.omega.cross(p);
       a = rt * a;
-      w = rt * w - omega_;
+      w = rt * w - f.omega;
     }
     x.block<3, 1>(kD * b, 0) = c - c0_[b];
     x.block<3, 1>(kD * b + 3, 0) = rotation_vector(a * a0_[b].transpose());
@@ -114,12 +147,7 @@ void ModalCoordinates::offsets(double t, const double* y, ModeBlock& x) const {
 bool ModalCoordinates::states(double t, const ModeBlock& x, double* y, double max_rotation,
                               int* far_body) {
   bool within = true;
-  Vec4 qr(1, 0, 0, 0);
-  if (turning_) {
-    qr = frame_quaternion(t);
-    rotation_ = rotation_matrix<double>(qr);
-  }
-  const Vec3 s = s0_ + velocity_ * (t - t0_);
+  for (Frame& f : frames_) f.at(t);
   for (size_t b = 0; b < c0_.size(); ++b) {
     double* y13 = y + kS * b;
     const Vec3 theta = x.block<3, 1>(kD * b + 3, 0);
@@ -133,13 +161,14 @@ bool ModalCoordinates::states(double t, const ModeBlock& x, double* y, double ma
     Vec3 c = c0_[b] + x.block<3, 1>(kD * b, 0);
     Vec3 v = x.block<3, 1>(kD * b, 1);
     Vec3 w = angular_velocity(theta, x.block<3, 1>(kD * b + 3, 1));  // global (frame) axes
-    if (turning_) {
+    if (frame_of_[b] >= 0) {
       // Back to fixed axes: c = s + R p, v = V + R (W x p + v), A = R A, body axes w + A^T W.
-      const Vec3 p = c - s0_;
-      c = s + rotation_ * p;
-      v = velocity_ + rotation_ * (omega_.cross(p) + v);
-      w += omega_;
-      q = quat_multiply(qr, q);
+      const Frame& f = frames_[frame_of_[b]];
+      const Vec3 p = c - f.s0;
+      c = f.s0 + f.velocity * (t - f.t0) + f.rotation * p;
+      v = f.velocity + f.rotation * (f.omega.cross(p) + v);
+      w += f.omega;
+      q = quat_multiply(f.q, q);
       q /= q.norm();
     }
     w = a.transpose() * w;  // body axes
@@ -163,14 +192,15 @@ bool ModalCoordinates::accelerations(const ModeBlock& x, const double* ydot,
     const Vec3 theta = x.block<3, 1>(kD * b + 3, 0), theta_rate = x.block<3, 1>(kD * b + 3, 1);
     Vec3 acceleration(d[7], d[8], d[9]);
     Vec3 angular = a * Vec3(d[10], d[11], d[12]);
-    if (turning_) {
+    if (frame_of_[b] >= 0) {
       // d2p/dt2 = R^T d2c/dt2 - 2 W x dp/dt - W x (W x p); the frame's angular acceleration
       // A (d omega_body / dt) + w x W, w the angular velocity in the frame.
-      const Vec3 p = c0_[b] + x.block<3, 1>(kD * b, 0) - s0_;
+      const Frame& f = frames_[frame_of_[b]];
+      const Vec3 p = c0_[b] + x.block<3, 1>(kD * b, 0) - f.s0;
       const Vec3 v = x.block<3, 1>(kD * b, 1);
-      acceleration = rotation_.transpose() * acceleration - 2.0 * omega_.cross(v) -
-                     omega_.cross(omega_.cross(p));
-      angular += angular_velocity(theta, theta_rate).cross(omega_);
+      acceleration = f.rotation.transpose() * acceleration - 2.0 * f.omega.cross(v) -
+                     f.omega.cross(f.omega.cross(p));
+      angular += angular_velocity(theta, theta_rate).cross(f.omega);
     }
     out.segment<3>(kD * b) = acceleration;
     out.segment<3>(kD * b + 3) = rotation_vector_acceleration(theta, theta_rate, angular);

@@ -5,11 +5,12 @@
 // velocity, angular velocity in the body frame). The angular velocity is omega = J(theta) dtheta/dt
 // (core/model/rotation.hpp), so dx/dt = u holds exactly.
 //
-// A scene that floats (core/model/model.hpp, floats) may be followed in a frame that turns with
-// it (set_turning_frame): the reference turns rigidly at a constant angular velocity W about a
-// centre moving at a constant velocity V, R(t) = exp([W](t - t0)), and the offsets are taken in
+// A part of the scene that floats (floating_parts: free bodies joined to each other by elements
+// and to nothing fixed) and spins may be followed in a frame that turns with it
+// (set_turning_frame): the part's reference turns rigidly at a constant angular velocity W about a
+// centre moving at a constant velocity V, R(t) = exp([W](t - t0)), and its offsets are taken in
 // that frame: c = s(t) + R (c0 + dc - s0) with s(t) = s0 + V (t - t0), A = R exp([theta]x) A0.
-// The elastic forces turn with the bodies, so a rigid spin of the whole is no offset at all; in
+// The elastic forces turn with the bodies, so a rigid spin of the part is no offset at all; in
 // fixed axes it is a second-order offset along the stiff modes that the exponential method treats
 // as an explicit remainder of size K0 x offset (a free pair on a steel rod spinning at 8 rad/s:
 // 6.6e3 N standing for 0.34 N of centripetal force), whose error its estimates miss (12 to 537
@@ -27,19 +28,20 @@
 
 namespace beamrail {
 
-// True when the scene floats: it has free bodies, and no element or joint ends on a fixed (or
-// driven) body, so that the free bodies can turn and move together as one rigid body and every
-// internal force turns with them (a spacecraft, a thrown or spinning assembly).
-bool floats(const Model& model);
+// The parts of the scene that float: each a set of free bodies (their indices in state order)
+// joined to each other through elements and joints and to no fixed or driven body, so that they
+// can turn and move together as one rigid body with every internal force turning with them (a
+// spacecraft, a thrown or spinning assembly). Free bodies joined to a fixed body are in none.
+std::vector<std::vector<int>> floating_parts(const Model& model);
 
-// The motion of the free bodies of the 13 states y as one rigid body: the centre of mass, its
-// velocity, and the angular velocity I^-1 L (L the angular momentum about the centre, I the
-// inertia of the whole about it; directions of I below 1e-12 of its largest are left out) [m,
-// m/s, rad/s].
+// The motion of the free bodies `part` (indices in state order) of the 13 states y as one rigid
+// body: the centre of mass, its velocity, and the angular velocity I^-1 L (L the angular momentum
+// about the centre, I the inertia of the part about it; directions of I below 1e-12 of its
+// largest are left out) [m, m/s, rad/s].
 struct RigidMotion {
   Vec3 centre = Vec3::Zero(), velocity = Vec3::Zero(), angular_velocity = Vec3::Zero();
 };
-RigidMotion rigid_motion(const Model& model, const double* y);
+RigidMotion rigid_motion(const Model& model, const double* y, const std::vector<int>& part);
 
 class ModalCoordinates {
  public:
@@ -48,10 +50,16 @@ class ModalCoordinates {
   void set_reference(const double* states, int bodies);
   int bodies() const { return static_cast<int>(c0_.size()); }
 
-  // The reference turns with `motion` from t0 on (see above); without a call it stays still.
-  void set_turning_frame(double t0, const RigidMotion& motion);
-  bool turning() const { return turning_; }
-  const Vec3& frame_angular_velocity() const { return omega_; }
+  // The reference of the bodies `part` (state order) turns with `motion` from t0 on (see above);
+  // without a call it stays still. After set_reference.
+  void set_turning_frame(double t0, const RigidMotion& motion, const std::vector<int>& part);
+  bool turning() const { return !frames_.empty(); }
+  // The fastest turning frame's angular velocity [rad/s]; 0 without one.
+  double fastest_frame_rate() const;
+  // That of the frame of body b (state order) [rad/s]; 0 in fixed axes.
+  double frame_rate(int b) const {
+    return frame_of_[b] >= 0 ? frames_[frame_of_[b]].omega.norm() : 0.0;
+  }
 
   // The offsets and their rates (x: 6 per body, 2 columns) of the 13 states y at time t.
   void offsets(double t, const double* y, ModeBlock& x) const;
@@ -76,18 +84,21 @@ class ModalCoordinates {
   }
 
  private:
-  Mat3 frame_rotation(double t) const;  // R(t)
-  Vec4 frame_quaternion(double t) const;
+  // A turning frame: R(t) = exp([omega] (t - t0)) about s0 + velocity (t - t0).
+  struct Frame {
+    double t0 = 0.0;
+    Vec3 s0 = Vec3::Zero(), velocity = Vec3::Zero(), omega = Vec3::Zero();
+    Vec4 q = Vec4(1, 0, 0, 0);         // R at the time of the last states(), as a quaternion
+    Mat3 rotation = Mat3::Identity();  // and as a matrix
+    void at(double t);                 // sets q and rotation to R(t)
+  };
 
   std::vector<Vec3> c0_;
   std::vector<Vec4> q0_;
   std::vector<Mat3> a0_;
   std::vector<Mat3> orientation_;  // the rotation matrices (in the frame) states() last wrote
-  // The turning frame: R(t) = exp([omega_] (t - t0_)) about s0_ + velocity_ (t - t0_).
-  bool turning_ = false;
-  double t0_ = 0.0;
-  Vec3 s0_ = Vec3::Zero(), velocity_ = Vec3::Zero(), omega_ = Vec3::Zero();
-  Mat3 rotation_ = Mat3::Identity();  // R at the time of the last states()
+  std::vector<Frame> frames_;
+  std::vector<int> frame_of_;  // per body the index of its frame in frames_, -1: fixed axes
 };
 
 }  // namespace beamrail

@@ -81,10 +81,16 @@ class ModalExponential : public Integrator {
     compute_wrenches(model, data, c.force_time(t0));
     compute_tangent(model, data, c.force_time(t0), false);
     coordinates_.set_reference(reference.data(), model.n_free());
-    // A scene that floats, spinning: its reference turns with it (modal_coordinates.hpp).
-    if (floats(model)) {
-      const RigidMotion motion = rigid_motion(model, y);
-      if (motion.angular_velocity.norm() > 0.0) coordinates_.set_turning_frame(t0, motion);
+    // A part of the scene that floats and spins: its reference turns with it
+    // (modal_coordinates.hpp), when it turns more than kTurningFrameMinTurn by the end of the run
+    // (1 s when the run gives no end): a part that barely turns, or not at all (an angular
+    // velocity of rounding, 5e-11 rad/s on a moving pair of tiny inertias), is followed in fixed
+    // axes, without the frame's step bound (that pair: 4 steps instead of a million).
+    const double span = o.horizon > t0 ? o.horizon - t0 : 1.0;
+    for (const std::vector<int>& part : floating_parts(model)) {
+      const RigidMotion motion = rigid_motion(model, y, part);
+      if (motion.angular_velocity.norm() * span > kTurningFrameMinTurn)
+        coordinates_.set_turning_frame(t0, motion, part);
     }
     if (band_hz_ > 0.0 || o.choose_band) {
       if (!band_limited_basis(model, data, t0, y, error)) return false;
@@ -561,6 +567,9 @@ class ModalExponential : public Integrator {
   static constexpr double kTurningFrameStep = 1.0;
   static constexpr double kTurningFrameRtol = 1e-8;
   static constexpr double kTurningFrameLongestStep = 3.0;
+  // A floating part is followed in a turning frame when it turns more than this over the run
+  // [rad].
+  static constexpr double kTurningFrameMinTurn = 1e-3;
   static constexpr double kToleranceScale = 10.0;
   static constexpr double kLowOrderScale = 3.0;
 
@@ -662,27 +671,25 @@ class ModalExponential : public Integrator {
       const Model& model = context_->model;
       detail_ = "body \"" + model.bodies[model.free_bodies[far_body_]].name +
                 "\" turned more than " + rotation_limit_text() +
-                " from the orientation it is linearized about" + turning_text() +
+                " from the orientation it is linearized about" + turning_text(far_body_) +
                 ": the modal integrator is for small motions about one configuration; use bdf "
                 "or dirk";
     }
     return flag;
   }
 
-  // " (turning with the scene at W rad/s)" in a turning frame, else "".
-  std::string turning_text() const {
-    if (!coordinates_.turning()) return "";
+  // " (turning with its part of the scene at W rad/s)" for a body in a turning frame, else "".
+  std::string turning_text(int body) const {
+    const double rate = coordinates_.frame_rate(body);
+    if (!(rate > 0.0)) return "";
     char text[80];
-    std::snprintf(text, sizeof text, " (turning with the scene at %.3g rad/s)",
-                  coordinates_.frame_angular_velocity().norm());
+    std::snprintf(text, sizeof text, " (turning with its part of the scene at %.3g rad/s)", rate);
     return text;
   }
 
  public:
   // The angular velocity of the frame the run follows the scene in [rad/s]; 0 in fixed axes.
-  double frame_rate() const {
-    return coordinates_.turning() ? coordinates_.frame_angular_velocity().norm() : 0.0;
-  }
+  double frame_rate() const { return coordinates_.fastest_frame_rate(); }
 
  private:
   IntegratorOptions options_;

@@ -31,7 +31,7 @@
 // core/analysis/dense_product.hpp): the tower's 1 s run took 14.3 s on 2 threads, 15.8 s on 1
 // (AVX2 kernels; README "Why this machine ran the tower slower").
 // Accuracy degrades with the size of the motion: past kMaxRotation the run stops with a message
-// naming the body. A scene that floats and spins is followed in a frame turning with it
+// naming the body. A part of the scene that floats and spins is followed in a frame turning with it
 // (core/analysis/modal_coordinates.hpp): its rigid spin is no motion away from the linearization
 // there, and the steps stay below min(3, (rtol / 1e-8)^(1/4)) / w_max (kTurningFrameStep).
 //
@@ -77,8 +77,9 @@ inline constexpr int kModalNonFinite = -8;
 // passed the limit of set_modal_inertia_limit (y and t: the step's accepted state where it did).
 inline constexpr int kModalInertia = -21;
 
-// The angular velocity of the frame in which a modal integrator follows a floating scene that
-// spins (core/analysis/modal_coordinates.hpp) [rad/s]; 0 in fixed axes or for another integrator.
+// The angular velocity of the fastest frame in which a modal integrator follows a floating part
+// of the scene that spins (core/analysis/modal_coordinates.hpp) [rad/s]; 0 in fixed axes or for
+// another integrator.
 double modal_frame_rate(const Integrator& integrator);
 // The eigenvalues w^2 of a modal integrator's linearization: the smallest positive one and the
 // largest [1/s^2]. False when `integrator` is not a modal integrator.

@@ -10,8 +10,8 @@
 //   the current state (one eigenproblem) and the run goes on; when that happens more often than
 //   every kAutoMinStepsPerLinearization steps (a body spinning fast: relinearizing costs more than
 //   it saves), the rest of the run is integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps
-//   the fast modes it does not resolve). In a scene that floats and spins the rotation counts from
-//   a reference turning with the scene (core/analysis/modal_coordinates.hpp).
+//   the fast modes it does not resolve). In a part of the scene that floats and spins the rotation
+//   counts from a reference turning with that part (core/analysis/modal_coordinates.hpp).
 //
 // - A band it chose itself (for rtol) is widened when the inertia of the modes it keeps
 //   quasi-static (their motion at second order: core/analysis/modal_integrator.hpp,

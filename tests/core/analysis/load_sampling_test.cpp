@@ -1,0 +1,114 @@
+// Loads that change between the steps (core/analysis/transient.cpp: time_breakpoints,
+// harmonic_step_limit). A step's stages see a time function only at their own times: an
+// adversarial review (2026-11-29) found a load pulse between two output times and a harmonic
+// load in step with the outputs that every method missed entirely, the tip at rest and status
+// ok. Each run here against an explicit Verner 8(7) run whose steps are held below 1 ms, so that
+// it sees the load whatever the breakpoints.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "tests/support/transient_run.hpp"
+
+namespace beamrail {
+namespace {
+
+using testing::options;
+using testing::run_error;
+using testing::scene_from_json;
+using testing::simulate;
+using testing::TransientRun;
+
+// A 1 kg tip on a 0.5 m massless steel rod of 10 mm, clamped; `loads` on the tip.
+std::string cantilever(const std::string& loads) {
+  return R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"rod": {"shape": "circle", "diameter": 0.01}},
+    "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-4, 1e-4, 1e-4],
+                "position": [0.5, 0, 0]}],
+    "beams": [{"name": "b", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [0.5, 0, 0], "point3": [0, 1, 0], "material": "steel",
+               "section": "rod"}],
+    "loads": )" +
+         loads + "}";
+}
+
+TransientRun run(const Model& model, IntegratorMethod method, double t_end, double output_step,
+                 double rtol, double atol, double max_step = 0.0) {
+  TransientOptions o = options(t_end, output_step, rtol, atol);
+  o.integrator.method = method;
+  if (max_step > 0.0) {
+    o.integrator.table = "VERNER_8_5_6";
+    o.integrator.max_step = max_step;
+  }
+  return simulate(model, o);
+}
+
+// The tip's largest distance from where it started [m].
+double motion(const Model& model, const TransientRun& r) {
+  const int b = model.free_bodies.front();
+  double largest = 0.0;
+  for (const auto& s : r.samples)
+    largest = std::max(largest, (s.c[b] - r.samples.front().c[b]).norm());
+  return largest;
+}
+
+// A 200 N pulse of two smooth ramps, 0.30 .. 0.32 s up and 0.33 .. 0.35 s down, between outputs
+// 0.1 s apart: smooth ramps were no breakpoints, every method stepped over the pulse, and the
+// tip stayed at rest (Verner 8(7) at rtol 1e-11 too). Their ends are breakpoints now.
+TEST(LoadSampling, APulseBetweenTheOutputsMovesTheTipWhateverTheMethod) {
+  const Model model = scene_from_json(cantilever(R"([
+      {"type": "force", "body": "tip", "value": [0, 200, 0],
+       "time": {"type": "smooth_ramp", "from": 0.30, "to": 0.32}},
+      {"type": "force", "body": "tip", "value": [0, -200, 0],
+       "time": {"type": "smooth_ramp", "from": 0.33, "to": 0.35}}])"));
+  const TransientRun reference =
+      run(model, IntegratorMethod::kErk, 1.0, 0.1, 1e-11, 1e-14, /*max_step=*/1e-3);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  const double moved = motion(model, reference);
+  std::printf("reference: the tip moves %.3g m\n", moved);
+  ASSERT_GT(moved, 1e-4);
+  const double rtol = 1e-6;
+  for (IntegratorMethod method : {IntegratorMethod::kAuto, IntegratorMethod::kBdf,
+                                  IntegratorMethod::kDirk, IntegratorMethod::kErk}) {
+    const TransientRun r = run(model, method, 1.0, 0.1, rtol, 1e-2 * rtol);
+    ASSERT_TRUE(r.result.ok) << method_name(method) << ": " << r.result.message;
+    const double e = run_error(model, r, reference);
+    std::printf("%s, rtol 1e-6: error %.3g = %.3g rtol, %ld steps\n", method_name(method),
+                e, e / rtol, r.result.stats.steps);
+    // Measured: auto 1.4, bdf 3.8, dirk 9.0, erk 0.004 rtol (before: 1 of the motion, 1e6 rtol).
+    EXPECT_LT(e, 10 * rtol) << method_name(method);
+  }
+}
+
+// A 100 Hz load of 1 kN, outputs every 0.01 s: auto took one step per output and its stages
+// (at 0, h/2 and h) met the sine at its zeros only; the tip stayed at rest at every rtol (an
+// error of 1e4 .. 1e8 rtol). Steps are now at most 1 / (2 pi f) long, about six per period.
+// What is left is 9.6 / 24 / 40 rtol of the motion at rtol 1e-4 / 1e-6 / 1e-8: the tolerances
+// weigh the tip's position, 0.5 m from the origin, and it moves 0.032 m, so rtol of its
+// position is 16 rtol of its motion (README "Loads between the steps").
+TEST(LoadSampling, AHarmonicLoadInStepWithTheOutputsIsSampled) {
+  const double f = 100.0, t_end = 0.5;
+  const Model model = scene_from_json(cantilever(R"([
+      {"type": "force", "body": "tip", "value": [0, 1000, 0],
+       "time": {"type": "harmonic", "frequency": 100}}])"));
+  const TransientRun reference =
+      run(model, IntegratorMethod::kErk, t_end, 0.01, 1e-11, 1e-14, /*max_step=*/1e-4);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  std::printf("reference: the tip moves %.3g m\n", motion(model, reference));
+  for (double rtol : {1e-4, 1e-6, 1e-8}) {
+    const TransientRun r = run(model, IntegratorMethod::kAuto, t_end, 0.01, rtol, 1e-2 * rtol);
+    ASSERT_TRUE(r.result.ok) << r.result.message;
+    const double e = run_error(model, r, reference);
+    std::printf("auto, rtol %.0e: error %.3g = %.3g rtol, %ld steps\n", rtol, e, e / rtol,
+                r.result.stats.steps);
+    EXPECT_GE(r.result.stats.steps, static_cast<long>(t_end * 2 * std::numbers::pi * f));
+    EXPECT_LT(e, 100 * rtol) << "rtol " << rtol;
+  }
+}
+
+}  // namespace
+}  // namespace beamrail

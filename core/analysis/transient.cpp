@@ -192,9 +192,10 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   }
   IntegratorOptions io = options.integrator;
   io.horizon = options.t_end;
-  if (const double longest = harmonic_step_limit(model);
-      longest > 0.0 && !(io.fixed_step > 0.0) && !(io.max_step > 0.0 && io.max_step <= longest))
-    io.max_step = longest;
+  const double harmonic_step = harmonic_step_limit(model);
+  const bool harmonic_held = harmonic_step > 0.0 && !(io.fixed_step > 0.0) &&
+                             !(io.max_step > 0.0 && io.max_step <= harmonic_step);
+  if (harmonic_held) io.max_step = harmonic_step;
   DeformationCheck deformation(model);
   try {
     SundialsContext ctx;
@@ -267,6 +268,14 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
           result.timed_out = context.timed_out;
           result.interrupted = context.interrupted;
           result.message = context.interrupted ? "interrupted" : integrator->failure(flag);
+          if (harmonic_held && result.message.find("max_steps") != std::string::npos) {
+            char why[160];
+            std::snprintf(why, sizeof why,
+                          "; with its harmonic loads or drives no step is longer than %.3g s, "
+                          "1 / (2 pi f) for the highest frequency f (%.6g Hz)",
+                          harmonic_step, 1.0 / (2.0 * std::numbers::pi * harmonic_step));
+            result.message += why;
+          }
           break;
         }
         if (at_break && t >= stop) {

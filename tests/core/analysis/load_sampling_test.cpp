@@ -110,5 +110,21 @@ TEST(LoadSampling, AHarmonicLoadInStepWithTheOutputsIsSampled) {
   }
 }
 
+// A load too fast for the step budget: the run fails, and says that the load holds the steps
+// (loosening rtol would not help).
+TEST(LoadSampling, ALoadTooFastForTheStepBudgetFailsNamingTheStepItHolds) {
+  const Model model = scene_from_json(cantilever(R"([
+      {"type": "force", "body": "tip", "value": [0, 1, 0],
+       "time": {"type": "harmonic", "frequency": 1e6}}])"));
+  TransientOptions o = options(1.0, 0.1, 1e-6, 1e-8);
+  o.integrator.max_steps = 10000;
+  const TransientRun r = simulate(model, o);
+  EXPECT_FALSE(r.result.ok);
+  EXPECT_NE(r.result.message.find("max_steps"), std::string::npos) << r.result.message;
+  EXPECT_NE(r.result.message.find("no step is longer than 1.59e-07 s"), std::string::npos)
+      << r.result.message;
+  EXPECT_EQ(r.result.stats.steps, 10000);
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -30,26 +30,46 @@ TransientSample sample_at(const Model& model, Data& data, double t, const double
   return s;
 }
 
-// Where the integrators stop for the time function f: where its factor or its slope jumps, and
-// the two ends of a smooth ramp. Its slope is continuous there, but a step longer than the ramp
-// could step over it unseen: a load pulse of two smooth ramps, 0.30 .. 0.35 s, on a cantilever
-// at rest came out as no motion at all from every method, Verner 8(7) at rtol 1e-11 included
-// (an adversarial review, 2026-11-29).
-void append_stops(const TimeFunction& f, std::vector<double>& times) {
-  f.append_breakpoints(times);
-  if (f.type == TimeFunction::Type::kSmoothRamp) times.insert(times.end(), {f.from, f.to});
+// A time the integrators stop at: where a time function's factor or its slope jumps (the method
+// restarts there), or an end of a smooth ramp (its slope and curvature are continuous: the method
+// goes on without a restart). A step longer than a smooth ramp could pass over it unseen: a load
+// pulse of two smooth ramps, 0.30 .. 0.35 s, on a cantilever at rest came out as no motion at
+// all from every method, Verner 8(7) at rtol 1e-11 included (an adversarial review, 2026-11-29).
+// Restarting there instead cost bdf its order at every ramp end: with 1,000 overlapping ramps
+// its error at rtol 1e-6 went from 1.7e-5 to 1.6e-4 of the motion (the next review).
+struct Stop {
+  double t = 0.0;
+  bool restart = true;
+};
+
+// The stops of the time function f of a load or drive whose vector is not zero (a function
+// that scales nothing neither stops nor holds the steps).
+void append_stops(const TimeFunction& f, const Vec3& scaled, std::vector<Stop>& stops) {
+  if (scaled.isZero(0.0)) return;
+  std::vector<double> jumps;
+  f.append_breakpoints(jumps);
+  for (double t : jumps) stops.push_back({t, true});
+  if (f.type == TimeFunction::Type::kSmoothRamp)
+    stops.insert(stops.end(), {{f.from, false}, {f.to, false}});
 }
 
-std::vector<double> time_breakpoints(const Model& model, double t_end) {
-  std::vector<double> all, inside;
-  for (const Load& load : model.loads) append_stops(load.time, all);
+// The stops inside (0, t_end), in order, one per time (restarting if any there does).
+std::vector<Stop> time_breakpoints(const Model& model, double t_end) {
+  std::vector<Stop> all, inside;
+  for (const Load& load : model.loads) append_stops(load.time, load.value, all);
   for (int i : model.driven_bodies) {  // a drive's velocity jumps or kinks there
-    append_stops(model.bodies[i].motion.velocity_time, all);
-    append_stops(model.bodies[i].motion.angular_velocity_time, all);
+    const PrescribedMotion& m = model.bodies[i].motion;
+    append_stops(m.velocity_time, m.velocity, all);
+    append_stops(m.angular_velocity_time, m.angular_velocity, all);
   }
-  std::sort(all.begin(), all.end());
-  for (double t : all)
-    if (t > 0.0 && t < t_end && (inside.empty() || t > inside.back())) inside.push_back(t);
+  std::sort(all.begin(), all.end(), [](const Stop& a, const Stop& b) { return a.t < b.t; });
+  for (const Stop& s : all) {
+    if (!(s.t > 0.0 && s.t < t_end)) continue;
+    if (!inside.empty() && !(s.t > inside.back().t))
+      inside.back().restart = inside.back().restart || s.restart;
+    else
+      inside.push_back(s);
+  }
   return inside;
 }
 
@@ -63,13 +83,15 @@ std::vector<double> time_breakpoints(const Model& model, double t_end) {
 // run was 9.6 / 24 / 40 rtol off at rtol 1e-4 / 1e-6 / 1e-8, not 1e4 / 1e6 / 1e8.
 double harmonic_step_limit(const Model& model) {
   double highest = 0.0;
-  const auto consider = [&highest](const TimeFunction& f) {
-    if (f.type == TimeFunction::Type::kHarmonic) highest = std::max(highest, std::abs(f.frequency));
+  const auto consider = [&highest](const TimeFunction& f, const Vec3& scaled) {
+    if (f.type == TimeFunction::Type::kHarmonic && !scaled.isZero(0.0))
+      highest = std::max(highest, std::abs(f.frequency));
   };
-  for (const Load& load : model.loads) consider(load.time);
+  for (const Load& load : model.loads) consider(load.time, load.value);
   for (int i : model.driven_bodies) {
-    consider(model.bodies[i].motion.velocity_time);
-    consider(model.bodies[i].motion.angular_velocity_time);
+    const PrescribedMotion& m = model.bodies[i].motion;
+    consider(m.velocity_time, m.velocity);
+    consider(m.angular_velocity_time, m.angular_velocity);
   }
   return highest > 0.0 ? 1.0 / (2.0 * std::numbers::pi * highest) : 0.0;
 }
@@ -196,6 +218,18 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   const bool harmonic_held = harmonic_step > 0.0 && !(io.fixed_step > 0.0) &&
                              !(io.max_step > 0.0 && io.max_step <= harmonic_step);
   if (harmonic_held) io.max_step = harmonic_step;
+  const double highest_hz = harmonic_step > 0.0 ? 1.0 / (2.0 * std::numbers::pi * harmonic_step) : 0.0;
+  if (harmonic_held && options.t_end / harmonic_step > static_cast<double>(io.max_steps)) {
+    // Known before the run: it would spend every step of its budget and fail.
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "its harmonic loads or drives (%.6g Hz, the highest) hold every step to at most "
+                  "%.3g s, 1 / (2 pi f): t_end needs at least %.3g steps, more than max_steps "
+                  "(%ld); raise max_steps or shorten t_end",
+                  highest_hz, harmonic_step, options.t_end / harmonic_step, io.max_steps);
+    result.message = text;
+    return result;
+  }
   DeformationCheck deformation(model);
   try {
     SundialsContext ctx;
@@ -225,6 +259,15 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     }
     result.linear_solver = integrator->linear_solver;
     result.warnings = integrator->warnings;
+    if (harmonic_step > 0.0 && io.fixed_step > harmonic_step) {
+      char text[400];
+      std::snprintf(text, sizeof text,
+                    "fixed_step %.3g s is longer than 1 / (2 pi f) = %.3g s for its harmonic loads "
+                    "or drives (%.6g Hz, the highest): each period is sampled fewer than 2 pi "
+                    "times, and nothing estimates what the load does between the samples",
+                    io.fixed_step, harmonic_step, highest_hz);
+      result.warnings.push_back(text);
+    }
     result.jacobian_nonzeros = integrator->nnz;
 
     const long n_out =
@@ -238,7 +281,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     };
     deliver(0, 0.0);
 
-    const std::vector<double> breakpoints = time_breakpoints(model, options.t_end);
+    const std::vector<Stop> breakpoints = time_breakpoints(model, options.t_end);
     size_t next_break = 0;
     double t = 0.0;
     result.ok = true;
@@ -249,14 +292,18 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     for (long k = 1; k <= n_out && result.ok; ++k) {
       const double t_out = std::min(static_cast<double>(k) * options.output_step, options.t_end);
       while (t_out - t > same_time) {
-        // Never step across a load's jump: stop there and restart the method.
+        // Never step across a load's jump: stop there and restart the method (at a smooth
+        // ramp's end: stop, and go on).
         const bool at_break = next_break < breakpoints.size();
-        const double stop = at_break ? breakpoints[next_break] : options.t_end;
-        if (at_break && stop - t <= same_time) {  // there already
-          ++next_break;
-          normalize_quaternions(model, y.data());
+        const double stop = at_break ? breakpoints[next_break].t : options.t_end;
+        const auto pass = [&] {
+          if (!breakpoints[next_break++].restart) return;
           context.stretch_start = stop;
+          normalize_quaternions(model, y.data());
           integrator->restart(t, y);
+        };
+        if (at_break && stop - t <= same_time) {  // there already
+          pass();
           continue;
         }
         // A jump at the stretch's end (or at t_end) acts after it: the forces there are its left
@@ -273,17 +320,12 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
             std::snprintf(why, sizeof why,
                           "; with its harmonic loads or drives no step is longer than %.3g s, "
                           "1 / (2 pi f) for the highest frequency f (%.6g Hz)",
-                          harmonic_step, 1.0 / (2.0 * std::numbers::pi * harmonic_step));
+                          harmonic_step, highest_hz);
             result.message += why;
           }
           break;
         }
-        if (at_break && t >= stop) {
-          ++next_break;
-          normalize_quaternions(model, y.data());
-          context.stretch_start = stop;
-          integrator->restart(t, y);
-        }
+        if (at_break && t >= stop) pass();
       }
       if (result.ok) deliver(k, t_out);
       // An element outside the range of its law ends the run (checked at accepted states).

@@ -218,7 +218,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   const bool harmonic_held = harmonic_step > 0.0 && !(io.fixed_step > 0.0) &&
                              !(io.max_step > 0.0 && io.max_step <= harmonic_step);
   if (harmonic_held) io.max_step = harmonic_step;
-  const double highest_hz = harmonic_step > 0.0 ? 1.0 / (2.0 * std::numbers::pi * harmonic_step) : 0.0;
+  const double highest_hz =
+      harmonic_step > 0.0 ? 1.0 / (2.0 * std::numbers::pi * harmonic_step) : 0.0;
   if (harmonic_held && options.t_end / harmonic_step > static_cast<double>(io.max_steps)) {
     // Known before the run: it would spend every step of its budget and fail.
     char text[400];

@@ -77,8 +77,8 @@ TEST(LoadSampling, APulseBetweenTheOutputsMovesTheTipWhateverTheMethod) {
     const TransientRun r = run(model, method, 1.0, 0.1, rtol, 1e-2 * rtol);
     ASSERT_TRUE(r.result.ok) << method_name(method) << ": " << r.result.message;
     const double e = run_error(model, r, reference);
-    std::printf("%s, rtol 1e-6: error %.3g = %.3g rtol, %ld steps\n", method_name(method),
-                e, e / rtol, r.result.stats.steps);
+    std::printf("%s, rtol 1e-6: error %.3g = %.3g rtol, %ld steps\n", method_name(method), e,
+                e / rtol, r.result.stats.steps);
     // Measured: auto 1.4, bdf 0.37, dirk 2.3, erk 0.005 rtol (before: 1 of the motion, 1e6
     // rtol; restarting at the ramps' ends instead of going on: bdf 3.8, dirk 9.0).
     EXPECT_LT(e, 10 * rtol) << method_name(method);

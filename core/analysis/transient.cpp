@@ -82,6 +82,13 @@ std::vector<Stop> time_breakpoints(const Model& model, double t_end) {
 // rtol 1e-6 with longer steps). The bound keeps about six steps per period: at 1 / (2 pi f) that
 // run was 9.6 / 24 / 40 rtol off at rtol 1e-4 / 1e-6 / 1e-8, not 1e4 / 1e6 / 1e8.
 double harmonic_step_limit(const Model& model) {
+  const double highest = highest_harmonic_hz(model);
+  return highest > 0.0 ? 1.0 / (2.0 * std::numbers::pi * highest) : 0.0;
+}
+
+}  // namespace
+
+double highest_harmonic_hz(const Model& model) {
   double highest = 0.0;
   const auto consider = [&highest](const TimeFunction& f, const Vec3& scaled) {
     if (f.type == TimeFunction::Type::kHarmonic && !scaled.isZero(0.0))
@@ -93,10 +100,8 @@ double harmonic_step_limit(const Model& model) {
     consider(m.velocity_time, m.velocity);
     consider(m.angular_velocity_time, m.angular_velocity);
   }
-  return highest > 0.0 ? 1.0 / (2.0 * std::numbers::pi * highest) : 0.0;
+  return highest;
 }
-
-}  // namespace
 
 const char* method_name(IntegratorMethod method) {
   switch (method) {

@@ -152,6 +152,11 @@ inline constexpr size_t kMaxRecordedPhases = 20;
 
 using TransientObserver = std::function<void(const TransientSample&, const Data&)>;
 
+// The highest frequency of the scene's harmonic loads and drives that scale something (a
+// non-zero vector) [Hz]; 0 without one. No step of a transient is longer than 1 / (2 pi f)
+// (transient.cpp), and the modal method's steps stay shorter still (modal_integrator.cpp).
+double highest_harmonic_hz(const Model& model);
+
 // Runs the analysis; observer sees t = 0 and every output step (data holds that state). Never
 // throws: failures (solver, non-finite forces, observer errors) come back in the result, after the
 // samples reached so far were delivered.

@@ -73,19 +73,6 @@ std::vector<Stop> time_breakpoints(const Model& model, double t_end) {
   return inside;
 }
 
-// The longest step that still samples every harmonic load and drive: 1 / (2 pi f) for the
-// highest frequency f among them [s]; 0 without one. A step's stages see a time function only
-// at their own times, and neither the error estimates nor the step count see what happens in
-// between: a 100 Hz load on a cantilever with outputs every 0.01 s, one step per output, sampled
-// the sine at its zeros only (stages at 0, h/2 and h) and the run came out at rest, with status
-// ok (an adversarial review, 2026-11-29: every method and rtol; bdf 6.6 and dirk 95 rtol off at
-// rtol 1e-6 with longer steps). The bound keeps about six steps per period: at 1 / (2 pi f) that
-// run was 9.6 / 24 / 40 rtol off at rtol 1e-4 / 1e-6 / 1e-8, not 1e4 / 1e6 / 1e8.
-double harmonic_step_limit(const Model& model) {
-  const double highest = highest_harmonic_hz(model);
-  return highest > 0.0 ? 1.0 / (2.0 * std::numbers::pi * highest) : 0.0;
-}
-
 }  // namespace
 
 double highest_harmonic_hz(const Model& model) {
@@ -219,12 +206,19 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
   }
   IntegratorOptions io = options.integrator;
   io.horizon = options.t_end;
-  const double harmonic_step = harmonic_step_limit(model);
+  // The longest step that still samples every harmonic load and drive: 1 / (2 pi f) for the
+  // highest frequency f among them [s]; 0 without one. A step's stages see a time function only
+  // at their own times, and neither the error estimates nor the step count see what happens in
+  // between: a 100 Hz load on a cantilever with outputs every 0.01 s, one step per output, sampled
+  // the sine at its zeros only (stages at 0, h/2 and h) and the run came out at rest, with status
+  // ok (an adversarial review, 2026-11-29: every method and rtol; bdf 6.6 and dirk 95 rtol off at
+  // rtol 1e-6 with longer steps). The bound keeps about six steps per period: at 1 / (2 pi f) that
+  // run was 9.6 / 24 / 40 rtol off at rtol 1e-4 / 1e-6 / 1e-8, not 1e4 / 1e6 / 1e8.
+  const double highest_hz = highest_harmonic_hz(model);
+  const double harmonic_step = highest_hz > 0.0 ? 1.0 / (2.0 * std::numbers::pi * highest_hz) : 0.0;
   const bool harmonic_held = harmonic_step > 0.0 && !(io.fixed_step > 0.0) &&
                              !(io.max_step > 0.0 && io.max_step <= harmonic_step);
   if (harmonic_held) io.max_step = harmonic_step;
-  const double highest_hz =
-      harmonic_step > 0.0 ? 1.0 / (2.0 * std::numbers::pi * harmonic_step) : 0.0;
   if (harmonic_held && options.t_end / harmonic_step > static_cast<double>(io.max_steps)) {
     // Known before the run: it would spend every step of its budget and fail.
     char text[400];

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/analysis/explicit_stability.hpp"
 #include "core/analysis/modal_integrator.hpp"
 #include "core/model/element_kinds.hpp"
 
@@ -79,20 +78,25 @@ class AutoIntegrator : public Integrator {
     std::string reason = std::to_string(model.n_free()) + " free bod" +
                          (model.n_free() == 1 ? "y" : "ies") +
                          ": small motions about one configuration, each mode's vibration exact";
-    if (const double beta = largest_damping(model); beta > 0.0) {
+    if (double own = 0.0, coupling = 0.0; modal_damping(*modal, &own, &coupling) && own > 0.0) {
+      // Each mode's own damping is exact in its block; what couples the modes stays explicit.
       double lowest = 0.0, highest = 0.0;
       modal_spectrum(*modal, &lowest, &highest);
-      const double step = 2.5 / (beta * highest);
-      const double ratio = 0.5 * beta * std::sqrt(highest);
+      const double step = coupling > 0.0 ? 2.5 / coupling : 0.0;
+      const double ratio = 0.5 * coupling / std::sqrt(highest);
       if (ratio > kAutoMaxDampingRatio)
         return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
-                              "damping (beta " + number(beta) + " s) damps the fastest mode (" +
-                                  number(std::sqrt(highest)) + " rad/s) at " + number(ratio) +
-                                  " of critical: the modal method's explicit damping would hold "
-                                  "its steps below " +
+                              "damping that couples the modes (" + number(coupling) + " 1/s, " +
+                                  number(ratio) +
+                                  " of the fastest mode's critical "
+                                  "damping; the modes' own is exact) would hold the modal "
+                                  "method's steps below " +
                                   number(step) + " s; bdf steps over the decayed modes",
                               error);
-      reason += "; its damping allows steps up to " + number(step) + " s";
+      reason += "; each mode's damping exact (up to " + number(own) + " 1/s)";
+      if (step > 0.0)
+        reason += ", their coupling (" + number(coupling) + " 1/s) allows steps up to " +
+                  number(step) + " s";
     }
     if (const double rate = modal_frame_rate(*modal); rate > 0.0)
       reason += "; floating and spinning: followed in a frame turning with it (" + number(rate) +

@@ -1,10 +1,12 @@
 // The "auto" method of the transient analysis: it chooses per scene and per phase of the run.
 //
 // - At the start, the modal exponential integrator (core/analysis/modal_integrator.hpp)
-//   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless its
-//   fastest mode is damped beyond kAutoMaxDampingRatio (damping is explicit in the modal method):
-//   then bdf, as before auto. From kAutoChosenBandDofs on, the modal method's band is chosen for
-//   rtol (core/analysis/modal_band.hpp); bdf when no band of the modes it may ask for meets rtol.
+//   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless
+//   damping that couples its modes damps beyond kAutoMaxDampingRatio of the fastest mode's
+//   critical damping (each mode's own damping is exact in the modal method, the coupling
+//   explicit): then bdf, as before auto. From kAutoChosenBandDofs on, the modal method's band is
+//   chosen for rtol (core/analysis/modal_band.hpp); bdf when no band of the modes it may ask for
+//   meets rtol.
 // - When a body turns more than kAutoRelinearizeRotation (less after cheap relinearizations,
 //   below) from the orientation it is linearized about, the modal method is linearized again about
 //   the current state (one eigenproblem) and the run goes on; when that happens more often than
@@ -46,12 +48,16 @@ inline constexpr double kAutoFullRotationDofs = 600.0;
 inline constexpr long kAutoMinStepsPerLinearization = 10;
 // The implicit method auto falls back to mid-run.
 inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
-// Damping: the modal method treats stiffness-proportional damping beta explicitly, so its steps
-// stay below about 2.5 / (beta w_max^2); an L-stable implicit method steps over the damped fast
-// modes once they have decayed. auto takes bdf when the fastest mode's damping ratio
-// beta w_max / 2 exceeds this. Measured (scripts in the commit message): on the reference
-// cantilever in 10 segments at rtol 1e-6, modal/bdf wall 0.16 at ratio 0.01, 0.41 at 0.05,
-// 2.6 at 0.21, 9.3 at 0.83; the carriage of studies/carriage_two_rails.json (0.32): 2.7.
+// Damping: the modal method integrates each mode's own damping exactly (modal_damping,
+// core/analysis/modal_integrator.hpp) and the damping that couples the modes (members damped
+// differently) explicitly, so that coupling d [1/s] holds its steps below about 2.5 / d; an
+// L-stable implicit method steps over the damped fast modes once they have decayed. auto takes
+// bdf when d / (2 w_max) exceeds this. Measured while all damping was explicit (scripts in the
+// commit message of 2026-11): on the reference cantilever in 10 segments at rtol 1e-6,
+// modal/bdf wall 0.16 at a ratio of 0.01, 0.41 at 0.05, 2.6 at 0.21, 9.3 at 0.83. With each
+// mode's own damping exact, one `damping` for every member keeps the modal method at any
+// strength: there bdf was 8 to 161 rtol off on the lightly damped cantilevers of an adversarial
+// review (2026-11-29), the modal method within 1 rtol (README "Damped modes exact").
 inline constexpr double kAutoMaxDampingRatio = 0.1;
 
 // From this many degrees of freedom on, auto chooses the modal method's band for rtol

@@ -1,6 +1,7 @@
 // The step of the modal integrator (core/analysis/modal_integrator.hpp): functions of the 2 x 2
-// mode blocks B_i = [[0, 1], [-lambda_i, 0]] and the coefficient functions of the stiff-order-4
-// exponential Runge-Kutta method of Hochbruck and Ostermann (2005) with its embedded solutions.
+// mode blocks B_i = [[0, 1], [-lambda_i, -c_i]] (c_i a mode's damping, often 0) and the
+// coefficient functions of the stiff-order-4 exponential Runge-Kutta method of Hochbruck and
+// Ostermann (2005) with its embedded solutions.
 #pragma once
 
 #include <Eigen/Core>
@@ -13,8 +14,33 @@ namespace beamrail {
 // Any sign of lambda (negative: an unstable mode).
 std::array<double, 5> oscillator_g(double x);
 
+// phi_k(tau B), k = 0..4, of a damped mode block B = [[0, 1], [-lambda, -c]] (c >= 0, any sign
+// of lambda) as alpha_k I + beta_k B; with c = 0, alpha_k = g_k and beta_k = tau g_{k+1} at
+// x = lambda tau^2 (oscillator_g). Where the eigenvalues z of tau B are small (|z| < 2) from the
+// series sum_j (tau B)^j / (j + k)!, else from the scalar phi_k at the two eigenvalues (divided
+// differences). Near critical damping (c^2 / 4 close to lambda) with |z| >= 2 the divided
+// differences lose about a factor sqrt(lambda / |c^2 / 4 - lambda|), and at critical damping
+// they are not defined: a mode's damping is first taken off_critical.
+void damped_oscillator_phi(double lambda, double c, double tau, double alpha[5], double beta[5]);
+
+// A damping c >= 0 of a mode of eigenvalue lambda at least kCriticalMargin lambda away from
+// critical in c^2 / 4 - lambda: c itself, or moved to the nearer side's edge (by at most half of
+// kCriticalMargin relative). The modal integrator gives its modes' blocks this damping and
+// leaves the difference in its remainder (exact in sum).
+inline constexpr double kCriticalMargin = 1e-2;
+double off_critical(double lambda, double c);
+
 // Per mode a row: (eta, nu), or (x, u) in the physical basis.
 using ModeBlock = Eigen::Matrix<double, Eigen::Dynamic, 2>;
+
+// The linear part of the modes: B_i = [[0, 1], [-lambda_i, -damping_i]]; damping empty: every
+// mode undamped.
+struct ModeBlocks {
+  Eigen::ArrayXd lambda;
+  Eigen::ArrayXd damping;
+  Eigen::Index size() const { return lambda.size(); }
+  bool damped() const { return damping.size() > 0; }
+};
 
 // A function of the mode blocks B_i = [[0, 1], [-lambda_i, 0]], f(B_i) = alpha_i I + beta_i B_i.
 struct ModeFunction {
@@ -26,20 +52,24 @@ struct ModeFunction {
 
 // out += s f(B) z for the `count` modes from `begin` (inline: every stage of every step calls
 // it). Each mode's value is the same whatever the range it is computed in.
-inline void apply_add(const ModeFunction& f, const Eigen::ArrayXd& lambda, const ModeBlock& z,
+inline void apply_add(const ModeFunction& f, const ModeBlocks& blocks, const ModeBlock& z,
                       ModeBlock& out, double s, Eigen::Index begin, Eigen::Index count) {
   const auto a = z.col(0).segment(begin, count).array();
   const auto b = z.col(1).segment(begin, count).array();
   const auto alpha = f.alpha.segment(begin, count), beta = f.beta.segment(begin, count);
+  const auto lambda = blocks.lambda.segment(begin, count);
   out.col(0).segment(begin, count).array() += s * (alpha * a + beta * b);
-  out.col(1).segment(begin, count).array() +=
-      s * (alpha * b - beta * lambda.segment(begin, count) * a);
+  if (blocks.damped())
+    out.col(1).segment(begin, count).array() +=
+        s * (alpha * b - beta * (lambda * a + blocks.damping.segment(begin, count) * b));
+  else
+    out.col(1).segment(begin, count).array() += s * (alpha * b - beta * lambda * a);
 }
 
 // out += s f(B) z for every mode.
-inline void apply_add(const ModeFunction& f, const Eigen::ArrayXd& lambda, const ModeBlock& z,
+inline void apply_add(const ModeFunction& f, const ModeBlocks& blocks, const ModeBlock& z,
                       ModeBlock& out, double s = 1.0) {
-  apply_add(f, lambda, z, out, s, 0, z.rows());
+  apply_add(f, blocks, z, out, s, 0, z.rows());
 }
 
 // The coefficient functions of one step of size h of the stiff-order-4 exponential Runge-Kutta
@@ -69,8 +99,8 @@ struct StepFunctions {
   // fourth-order one takes stage 5 with the same weight b5 = 4 phi2 - 8 phi3: the two differ by
   // h b5 (N5 - N3), O(h^4).
 
-  // The functions of step `step` for the modes' eigenvalues lambda.
-  void compute(double step, const Eigen::ArrayXd& lambda);
+  // The functions of step `step` for the modes' blocks.
+  void compute(double step, const ModeBlocks& blocks);
 };
 
 }  // namespace beamrail

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "core/analysis/dense_product.hpp"
+#include "core/analysis/explicit_stability.hpp"
 #include "core/analysis/exponential_step.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/modal_band.hpp"
@@ -102,13 +103,17 @@ class ModalExponential : public Integrator {
       Eigen::VectorXd values;
       if (!solve_dense_eigenproblem(0.5 * (k + k.transpose()), Eigen::MatrixXd(m0_), values, phi_))
         return fail(error, "the modal integrator's eigensolver failed");
-      lambda_ = values.array();
+      blocks_.lambda = values.array();
       m_ = n_;
     }
-    if (coordinates_.turning() && lambda_.size() > 0 && lambda_.maxCoeff() > 0.0)
+    if (largest_damping(model) > 0.0 && !modal_damping(t0)) {
+      *error = "the modal integrator: the damping forces at the linearization are not finite";
+      return false;
+    }
+    if (coordinates_.turning() && blocks_.lambda.size() > 0 && blocks_.lambda.maxCoeff() > 0.0)
       turning_step_ = std::min(kTurningFrameStep * std::pow(o.rtol / kTurningFrameRtol, 0.25),
                                kTurningFrameLongestStep) /
-                      std::sqrt(lambda_.maxCoeff());
+                      std::sqrt(blocks_.lambda.maxCoeff());
     if (const double hz = highest_harmonic_hz(model); hz > 0.0)
       harmonic_step_ = kHarmonicStep * std::pow(o.rtol, 0.25) / (2.0 * std::numbers::pi * hz);
     from_states(y);
@@ -178,7 +183,9 @@ class ModalExponential : public Integrator {
     return text;
   }
 
-  const Eigen::ArrayXd& eigenvalues() const { return lambda_; }
+  const Eigen::ArrayXd& eigenvalues() const { return blocks_.lambda; }
+  const Eigen::ArrayXd& damping() const { return blocks_.damping; }
+  double damping_coupling() const { return damping_coupling_; }
   double step_size() const { return h_; }
 
   // The largest rotation of a body from the linearization at the accepted state [rad].
@@ -256,15 +263,53 @@ class ModalExponential : public Integrator {
     const Eigen::MatrixXd& vectors = band.vectors;
     phi_ = vectors.leftCols(m_);
     // The eigenvalues as Rayleigh quotients of this K0 (the static correction's).
-    lambda_.resize(m_);
+    blocks_.lambda.resize(m_);
     for (Eigen::Index i = 0; i < m_; ++i)
-      lambda_(i) = phi_.col(i).dot(k0 * phi_.col(i)) / phi_.col(i).dot(m0_ * phi_.col(i));
+      blocks_.lambda(i) = phi_.col(i).dot(k0 * phi_.col(i)) / phi_.col(i).dot(m0_ * phi_.col(i));
     reduced_ = m_ < n_;
     if (!reduced_) return true;
-    if (!quasi_.init(k0, m0_, phi_, lambda_, limit))
+    if (!quasi_.init(k0, m0_, phi_, blocks_.lambda, limit))
       return fail(error,
                   "a band-limited run (max_frequency_hz): the stiffness where it is linearized "
                   "has a mode of negative stiffness below the band's");
+    return true;
+  }
+
+  // The modes' damping c_i = phi_i^T M0 C phi_i (C = -da/du at the linearization, from central
+  // differences of the accelerations in the velocity phi_i: the forces linear in the velocities
+  // exactly, the gyroscopic ones, quadratic, cancelled) into blocks_.damping, integrated exactly
+  // with each mode's block; the rest of C (its coupling between modes) stays in N. Its size,
+  // |C phi_i - c_i phi_i| in M0's inverse (with every mode: the norm of the column of Phi^T M0 C
+  // Phi off its diagonal), largest over the modes, into damping_coupling_. False when the
+  // forces are not finite.
+  bool modal_damping(double t0) {
+    constexpr double kVelocity = 1e-3;  // the modal velocity of the differences
+    blocks_.damping.setZero(m_);
+    damping_coupling_ = 0.0;
+    Block x(n_, 2);
+    Eigen::VectorXd difference(n_);
+    for (Eigen::Index i = 0; i < m_; ++i) {
+      for (const double sign : {1.0, -1.0}) {
+        x.col(0).setZero();
+        x.col(1) = sign * kVelocity * phi_.col(i);
+        if (!states_of(t0, x, y13_.data()) || !accelerations(t0, x)) return false;
+        if (sign > 0.0)
+          difference = acceleration_;
+        else
+          difference -= acceleration_;
+      }
+      const Eigen::VectorXd column = (-0.5 / kVelocity) * difference;  // C phi_i, M0^-1 applied
+      const Eigen::VectorXd m0_column = m0_ * column;
+      const double mass = phi_.col(i).dot(m0_ * phi_.col(i));  // 1 but for rounding
+      double c = phi_.col(i).dot(m0_column) / mass;
+      const double size2 = column.dot(m0_column) / mass;
+      damping_coupling_ = std::max(damping_coupling_, std::sqrt(std::max(0.0, size2 - c * c)));
+      // Negative (rounding, or a velocity force that feeds the motion): left in N. Near
+      // critical damping the step's functions lose accuracy (exponential_step.hpp): the block
+      // takes a damping off it, N the difference.
+      blocks_.damping(i) = off_critical(blocks_.lambda(i), std::max(c, 0.0));
+    }
+    if (!(blocks_.damping.maxCoeff() > 0.0)) blocks_.damping.resize(0);
     return true;
   }
 
@@ -386,7 +431,8 @@ class ModalExponential : public Integrator {
       }
       last_size = size;
     }
-    out.col(1).array() += lambda_ * z.col(0).array();
+    out.col(1).array() += blocks_.lambda * z.col(0).array();
+    if (blocks_.damped()) out.col(1).array() += blocks_.damping * z.col(1).array();
     return true;
   }
 
@@ -424,10 +470,10 @@ class ModalExponential : public Integrator {
       // the method's sums (the pending stage is the last one summed).
       Block& target = i < s ? stage_z_[i % 2] : next_;
       target.setZero(m_, 2);
-      apply_add(i < s && StepFunctions::c[i] != 1.0 ? f.e_half : f.e_full, lambda_, z_, target);
+      apply_add(i < s && StepFunctions::c[i] != 1.0 ? f.e_half : f.e_full, blocks_, z_, target);
       for (int j = 0; j < i; ++j) {
         const ModeFunction& weight = i < s ? f.a[i][j] : f.b[j];
-        if (j != pending && !weight.empty()) apply_add(weight, lambda_, stage_n_[j], target, f.h);
+        if (j != pending && !weight.empty()) apply_add(weight, blocks_, stage_n_[j], target, f.h);
       }
       if (pending >= 0) {
         project_then(f, i, i < s ? target.data() : trial_.data(), i < s ? 2 : 6,
@@ -480,10 +526,13 @@ class ModalExponential : public Integrator {
     Block& n = stage_n_[j];
     const Block& zj = j == 0 ? z_ : stage_z_[j % 2];
     n.col(1).segment(begin, count).array() +=
-        lambda_.segment(begin, count) * zj.col(0).segment(begin, count).array();
+        blocks_.lambda.segment(begin, count) * zj.col(0).segment(begin, count).array();
+    if (blocks_.damped())
+      n.col(1).segment(begin, count).array() +=
+          blocks_.damping.segment(begin, count) * zj.col(1).segment(begin, count).array();
     const ModeFunction& weight = fill_stage_ < s ? f.a[fill_stage_][j] : f.b[j];
     Block& target = fill_stage_ < s ? stage_z_[fill_stage_ % 2] : next_;
-    if (!weight.empty()) apply_add(weight, lambda_, n, target, f.h, begin, count);
+    if (!weight.empty()) apply_add(weight, blocks_, n, target, f.h, begin, count);
     if (fill_stage_ == s) estimates(f, begin, count);
   }
 
@@ -493,13 +542,13 @@ class ModalExponential : public Integrator {
   void estimates(const StepFunctions& f, Eigen::Index begin, Eigen::Index count) {
     third_.resize(m_, 2);
     third_.middleRows(begin, count).setZero();
-    apply_add(f.b[4], lambda_, stage_n_[4], third_, f.h, begin, count);
-    apply_add(f.b[4], lambda_, stage_n_[2], third_, -f.h, begin, count);
+    apply_add(f.b[4], blocks_, stage_n_[4], third_, f.h, begin, count);
+    apply_add(f.b[4], blocks_, stage_n_[2], third_, -f.h, begin, count);
     second_.resize(m_, 2);
     second_.middleRows(begin, count) = next_.middleRows(begin, count);
-    apply_add(f.e_full, lambda_, z_, second_, -1.0, begin, count);
-    apply_add(f.low[0], lambda_, stage_n_[0], second_, -f.h, begin, count);
-    apply_add(f.low[1], lambda_, stage_n_[1], second_, -f.h, begin, count);
+    apply_add(f.e_full, blocks_, z_, second_, -1.0, begin, count);
+    apply_add(f.low[0], blocks_, stage_n_[0], second_, -f.h, begin, count);
+    apply_add(f.low[1], blocks_, stage_n_[1], second_, -f.h, begin, count);
     trial_.block(begin, 0, count, 2) = next_.middleRows(begin, count);
     trial_.block(begin, 2, count, 2) = third_.middleRows(begin, count);
     trial_.block(begin, 4, count, 2) = second_.middleRows(begin, count);
@@ -609,7 +658,7 @@ class ModalExponential : public Integrator {
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
-        full_.compute(h, lambda_);
+        full_.compute(h, blocks_);
         if (reduced_) quasi_.restore();  // not a rejected trial's
         int sflag = kOk;
         const bool ok = step(full_, &sflag);
@@ -723,10 +772,11 @@ class ModalExponential : public Integrator {
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
   Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
   Eigen::VectorXd m0_v_;          // work space of project
-  Eigen::ArrayXd lambda_;
-  ModalCoordinates coordinates_;  // the bodies' offsets from the linearization and back
-  Block z_, x_;                   // the accepted state, modal and physical (x_ = Phi z_)
-  Block xi_, x_next_;             // work space: a stage's physical state, a trial step's
+  ModeBlocks blocks_;  // the modes' linear part: eigenvalues and damping (exponential_step.hpp)
+  double damping_coupling_ = 0.0;  // modal_damping: the damping left in N, per mode velocity
+  ModalCoordinates coordinates_;   // the bodies' offsets from the linearization and back
+  Block z_, x_;                    // the accepted state, modal and physical (x_ = Phi z_)
+  Block xi_, x_next_;              // work space: a stage's physical state, a trial step's
   // A trial step's new state and its two error estimates side by side, modal and physical.
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
   // Work space: the modal states of the last two stages, a trial step's new state, its distances.
@@ -769,6 +819,14 @@ bool modal_spectrum(const Integrator& integrator, double* smallest_positive, dou
     if (lambda(i) > 1e-12 * *largest &&
         (*smallest_positive == 0.0 || lambda(i) < *smallest_positive))
       *smallest_positive = lambda(i);
+  return true;
+}
+
+bool modal_damping(const Integrator& integrator, double* largest, double* coupling) {
+  const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
+  if (!modal) return false;
+  *largest = modal->damping().size() ? modal->damping().maxCoeff() : 0.0;
+  *coupling = modal->damping_coupling();
   return true;
 }
 

@@ -11,11 +11,13 @@
 // the M0-normalized modes Phi (Phi^T K0 Phi = diag(lambda), Phi^T M0 Phi = I), x = Phi eta,
 // u = Phi nu and
 //   d eta / dt = nu,
-//   d nu / dt  = -lambda eta + [Phi^T M0 a(x, u) + lambda eta],
-// a being the exact accelerations (dv/dt, d^2 theta/dt^2) of the equations of motion. Each mode's
-// linear part [[0, 1], [-lambda, 0]] is integrated exactly (phi functions of 2 x 2 blocks); the
-// bracket (nonlinearity, load changes, damping, the non-symmetric part) by the stiff-order-4
-// exponential Runge-Kutta method of Hochbruck and Ostermann (2005). Steps are controlled by the
+//   d nu / dt  = -lambda eta - c nu + [Phi^T M0 a(x, u) + lambda eta + c nu],
+// a being the exact accelerations (dv/dt, d^2 theta/dt^2) of the equations of motion and c each
+// mode's own damping (phi^T M0 C phi, C = -da/du at the linearization; 0 without damping). Each
+// mode's linear part [[0, 1], [-lambda, -c]] is integrated exactly (phi functions of 2 x 2
+// blocks, core/analysis/exponential_step.hpp); the bracket (nonlinearity, load changes, damping
+// between modes, the non-symmetric part) by the stiff-order-4 exponential Runge-Kutta method of
+// Hochbruck and Ostermann (2005). Steps are controlled by the
 // distance to an embedded third-order solution from the same stages, measured in the physical
 // states; the fourth-order solution is kept (its error follows rtol: 0.01 .. 1.9 rtol measured,
 // transient_auto_test.cpp).
@@ -84,6 +86,12 @@ double modal_frame_rate(const Integrator& integrator);
 // The eigenvalues w^2 of a modal integrator's linearization: the smallest positive one and the
 // largest [1/s^2]. False when `integrator` is not a modal integrator.
 bool modal_spectrum(const Integrator& integrator, double* smallest_positive, double* largest);
+
+// A modal integrator's damping [1/s]: the largest of its modes' own (c_i = phi_i^T M0 C phi_i,
+// C the damping matrix at the linearization; integrated exactly with each mode) and the
+// largest coupling it leaves to the explicit remainder (per mode, the norm of C phi_i - c_i
+// phi_i in M0's inverse); both 0 without damping. False when `integrator` is not modal.
+bool modal_damping(const Integrator& integrator, double* largest, double* coupling);
 
 // How a modal integrator chose its band ("band 812 Hz: 40 of 5,994 modes, ..."); "" when it was
 // given or the integrator is not modal.

@@ -12,6 +12,9 @@
 namespace beamrail {
 namespace {
 
+// The highest frequency of a harmonic time function [Hz].
+constexpr double kMaxHarmonicFrequency = 1e12;
+
 std::string number_text(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", x);
@@ -177,6 +180,11 @@ std::optional<TimeFunctionT<S>> read_time_function(const Json& value, const Wher
     const auto freq = r.positive("frequency", true);
     f.phase = number("phase", r.number_or("phase", 0.0));
     if (!freq) return std::nullopt;
+    if (*freq > kMaxHarmonicFrequency) {
+      // Far beyond any mechanical load, and 2 pi f t would overflow at the top of the range.
+      r.error("frequency", "must be at most 1e12 Hz");
+      return std::nullopt;
+    }
     f.frequency = number("frequency", *freq);
     return f;
   }

@@ -528,6 +528,19 @@ TEST_F(BadInput, TableTimesNotIncreasing) {
                            "bad.json:/scene/loads/1/time/v:", "as many values as \"t\" (3)"));
 }
 
+// A harmonic frequency so high that 2 pi f overflowed made the loads non-finite: the run failed
+// (exit 1) instead of the input being refused.
+TEST_F(BadInput, HarmonicFrequencyBeyondAnyLoad) {
+  for (double f : {1.7e308, 1.01e12}) {
+    EXPECT_TRUE(
+        HasOnlyError(check(with("/scene/loads/0/time", {{"type", "harmonic"}, {"frequency", f}})),
+                     "bad.json:/scene/loads/0/time/frequency:", "must be at most 1e12 Hz"))
+        << f;
+  }
+  const Result r = check(with("/scene/loads/0/time", {{"type", "harmonic"}, {"frequency", 1e12}}));
+  EXPECT_EQ(r.err.find("frequency"), std::string::npos) << r.err;
+}
+
 TEST_F(BadInput, RampEndNotAfterItsStart) {
   EXPECT_TRUE(HasOnlyError(check(with("/scene/loads/0/time/to", 0.0)),
                            "bad.json:/scene/loads/0/time/to:", "must be greater than \"from\""));

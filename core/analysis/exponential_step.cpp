@@ -72,8 +72,9 @@ void damped_oscillator_phi(double lambda, double c, double tau, double alpha[5],
   const double p = lambda * tau * tau, s = 0.5 * c * tau;
   const double d2 = s * s - p;
   const Complex root = std::sqrt(Complex(d2, 0.0));
-  // The larger eigenvalue in size directly, the other from their product p (no cancellation).
-  const Complex big = -s - root;
+  // The larger eigenvalue in size directly, the other from their product p (no cancellation;
+  // -s and the root of the same sign, whatever the sign of c).
+  const Complex big = s >= 0.0 ? -s - root : -s + root;
   const Complex small = std::abs(big) > 0.0 ? Complex(p, 0.0) / big : Complex(0.0, 0.0);
   if (std::abs(big) < kSeriesRadius) {
     // T^j = P_j I + Q_j T: T^{j+1} = -p Q_j I + (P_j - 2 s Q_j) T; phi_k(T) = sum_j T^j / (j+k)!.

@@ -14,8 +14,8 @@ namespace beamrail {
 // Any sign of lambda (negative: an unstable mode).
 std::array<double, 5> oscillator_g(double x);
 
-// phi_k(tau B), k = 0..4, of a damped mode block B = [[0, 1], [-lambda, -c]] (c >= 0, any sign
-// of lambda) as alpha_k I + beta_k B; with c = 0, alpha_k = g_k and beta_k = tau g_{k+1} at
+// phi_k(tau B), k = 0..4, of a damped mode block B = [[0, 1], [-lambda, -c]] (any signs of c and
+// lambda) as alpha_k I + beta_k B; with c = 0, alpha_k = g_k and beta_k = tau g_{k+1} at
 // x = lambda tau^2 (oscillator_g). Where the eigenvalues z of tau B are small (|z| < 2) from the
 // series sum_j (tau B)^j / (j + k)!, else from the scalar phi_k at the two eigenvalues (divided
 // differences). Near critical damping (c^2 / 4 close to lambda) with |z| >= 2 the divided

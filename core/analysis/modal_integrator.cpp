@@ -28,6 +28,17 @@ namespace {
 
 constexpr int kD = kDofsPerBody;
 
+// True when a free body moves as a mechanism: not held by beams and fixed joints to the ground
+// (a pendulum on a joint, a carriage on a rail) and not part of a floating part.
+bool moves_as_mechanism(const Model& model) {
+  std::vector<char> floating(model.n_free(), 0);
+  for (const std::vector<int>& part : floating_parts(model))
+    for (int i : part) floating[i] = 1;
+  for (int i : free_bodies_not_held(model))
+    if (!floating[i]) return true;
+  return false;
+}
+
 using Block = ModeBlock;
 
 // out = a b (a change of basis of both columns; a is n x n, or a band's n x m basis or its
@@ -110,10 +121,20 @@ class ModalExponential : public Integrator {
       *error = "the modal integrator: the damping forces at the linearization are not finite";
       return false;
     }
-    if (coordinates_.turning() && blocks_.lambda.size() > 0 && blocks_.lambda.maxCoeff() > 0.0)
-      turning_step_ = std::min(kTurningFrameStep * std::pow(o.rtol / kTurningFrameRtol, 0.25),
-                               kTurningFrameLongestStep) /
-                      std::sqrt(blocks_.lambda.maxCoeff());
+    if (blocks_.lambda.size() > 0 && blocks_.lambda.maxCoeff() > 0.0) {
+      const double w_max = std::sqrt(blocks_.lambda.maxCoeff());
+      if (coordinates_.turning())
+        turning_step_ = std::min(kTurningFrameStep * std::pow(o.rtol / kTurningFrameRtol, 0.25),
+                                 kTurningFrameLongestStep) /
+                        w_max;
+      if (moves_as_mechanism(model)) {
+        const double bound =
+            std::min(kMechanismStep * std::pow(o.rtol / kMechanismRtol, 1.0 / 6.0),
+                     kMechanismLongestStep) /
+            w_max;
+        turning_step_ = turning_step_ > 0.0 ? std::min(turning_step_, bound) : bound;
+      }
+    }
     if (const double hz = highest_harmonic_hz(model); hz > 0.0)
       harmonic_step_ = kHarmonicStep * std::pow(o.rtol, 0.25) / (2.0 * std::numbers::pi * hz);
     from_states(y);
@@ -620,6 +641,21 @@ class ModalExponential : public Integrator {
   static constexpr double kTurningFrameStep = 1.0;
   static constexpr double kTurningFrameRtol = 1e-8;
   static constexpr double kTurningFrameLongestStep = 3.0;
+  // A mechanism (a body not held by beams and fixed joints to the ground, in no floating part: a
+  // pendulum on a joint) turns its stiff directions with it too, and the estimates miss the same
+  // thing: a pendulum of a 0.5 kg arm on a revolute joint (relative compliance 1e-3, w_max 1.23e6
+  // rad/s) and a 1 kg bob on a 0.25 m rod, swinging at 4 rad/s, 1 s, came out 37.6 rtol off at
+  // rtol 1e-4 (auto's own steps, w_max h ~ 30; the energy check warned) against an explicit Verner
+  // run at rtol 1e-11. Its error went as (w_max h)^6.5 at each rtol and hardly with the swing
+  // (0.05, 1 and 2 times that speed: 0.0019, 0.0020, 0.0044 rtol at w_max h = 3 and rtol 1e-4;
+  // at 0.05 times, the estimates' own steps left 44 rtol at rtol 1e-4 and, held to w_max h
+  // <= 0.1 / (the rotation from the linearization), still 51 at 1e-8: the long steps right after
+  // each relinearization count). So the steps stay below kMechanismStep (rtol /
+  // kMechanismRtol)^(1/6) / w_max, at most kMechanismLongestStep / w_max: 6, 3, 1.4 at rtol 1e-4,
+  // 1e-6, 1e-8.
+  static constexpr double kMechanismStep = 3.0;
+  static constexpr double kMechanismRtol = 1e-6;
+  static constexpr double kMechanismLongestStep = 6.0;
   // With a harmonic load of frequency f (the highest), the steps stay below kHarmonicStep
   // rtol^(1/4) / (2 pi f): the third-order estimate compares two evaluations at the same time
   // (c = 1/2) and cannot see a load's change within the step, and the second-order one saw too
@@ -795,7 +831,7 @@ class ModalExponential : public Integrator {
   std::string detail_;
   double max_rotation_ = kModalIntegratorMaxRotation;
   // In a turning frame (a floating scene that spins), the longest step: kTurningFrameStep / w of
-  // the fastest mode integrated [s]; 0: none.
+  // the fastest mode integrated [s]; with a mechanism, at most kMechanismStep's bound; 0: none.
   double turning_step_ = 0.0;
   double harmonic_step_ = 0.0;     // with harmonic loads, the longest step (kHarmonicStep) [s]
   double low_order_weight_ = 1.0;  // rtol^(1/4) / kLowOrderScale

@@ -66,7 +66,7 @@ double characteristic_length(const Model& model) {
   return l > 0.0 ? l : 1.0;
 }
 
-bool held_by_beams(const Model& model) {
+std::vector<int> free_bodies_not_held(const Model& model) {
   std::vector<int> parent(model.bodies.size());
   for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
   const auto root = [&](int i) {
@@ -80,9 +80,12 @@ bool held_by_beams(const Model& model) {
   std::vector<char> grounded(model.bodies.size(), 0);
   for (size_t i = 0; i < model.bodies.size(); ++i)
     if (model.bodies[i].fixed) grounded[root(static_cast<int>(i))] = 1;
-  for (int i : model.free_bodies)
-    if (!grounded[root(i)]) return false;
-  return true;
+  std::vector<int> out;
+  for (int i = 0; i < model.n_free(); ++i)
+    if (!grounded[root(model.free_bodies[i])]) out.push_back(i);
+  return out;
 }
+
+bool held_by_beams(const Model& model) { return free_bodies_not_held(model).empty(); }
 
 }  // namespace beamrail

@@ -231,6 +231,9 @@ double characteristic_length(const Model& model);
 // or mechanism mode). Spherical and revolute joints leave rotations free and do not count: a body
 // they hang from is a pendulum, whose stiffness under no load is singular (docs/model.md "Joints").
 bool held_by_beams(const Model& model);
+// The free bodies (indices into Model::free_bodies) that are not so held: a mechanism's bodies and
+// the bodies of floating parts.
+std::vector<int> free_bodies_not_held(const Model& model);
 
 constexpr int kStatesPerBody = 13;
 constexpr int kDofsPerBody = 6;

@@ -127,13 +127,10 @@ class ModalExponential : public Integrator {
         turning_step_ = std::min(kTurningFrameStep * std::pow(o.rtol / kTurningFrameRtol, 0.25),
                                  kTurningFrameLongestStep) /
                         w_max;
-      if (moves_as_mechanism(model)) {
-        const double bound =
-            std::min(kMechanismStep * std::pow(o.rtol / kMechanismRtol, 1.0 / 6.0),
-                     kMechanismLongestStep) /
-            w_max;
-        turning_step_ = turning_step_ > 0.0 ? std::min(turning_step_, bound) : bound;
-      }
+      if (moves_as_mechanism(model))
+        mechanism_step_ = std::min(kMechanismStep * std::pow(o.rtol / kMechanismRtol, 0.25),
+                                   kMechanismLongestStep) /
+                          w_max;
     }
     if (const double hz = highest_harmonic_hz(model); hz > 0.0)
       harmonic_step_ = kHarmonicStep * std::pow(o.rtol, 0.25) / (2.0 * std::numbers::pi * hz);
@@ -211,6 +208,21 @@ class ModalExponential : public Integrator {
 
   // The largest rotation of a body from the linearization at the accepted state [rad].
   double largest_rotation() const { return coordinates_.largest_rotation(x_); }
+
+  // The share of the modal energy sum 1/2 (zdot_i^2 + lambda_i z_i^2) (from the linearization's
+  // reference) in the modes above kMechanismStiffModes w_max, at the accepted state.
+  double stiff_share() const {
+    const double lambda_max = blocks_.lambda.maxCoeff();
+    const double lambda_stiff = kMechanismStiffModes * kMechanismStiffModes * lambda_max;
+    double total = 0.0, stiff = 0.0;
+    for (int i = 0; i < m_; ++i) {
+      const double lambda = std::max(blocks_.lambda[i], 0.0);
+      const double e = z_(i, 1) * z_(i, 1) + lambda * z_(i, 0) * z_(i, 0);
+      total += e;
+      if (lambda > lambda_stiff) stiff += e;
+    }
+    return total > 0.0 ? stiff / total : 0.0;
+  }
 
   std::string failure(int flag) const override {
     if (context_->timed_out) return "timeout: the run exceeded its max_seconds budget";
@@ -643,19 +655,29 @@ class ModalExponential : public Integrator {
   static constexpr double kTurningFrameLongestStep = 3.0;
   // A mechanism (a body not held by beams and fixed joints to the ground, in no floating part: a
   // pendulum on a joint) turns its stiff directions with it too, and the estimates miss the same
-  // thing: a pendulum of a 0.5 kg arm on a revolute joint (relative compliance 1e-3, w_max 1.23e6
+  // thing. A pendulum of a 0.5 kg arm on a revolute joint (relative compliance 1e-3, w_max 1.23e6
   // rad/s) and a 1 kg bob on a 0.25 m rod, swinging at 4 rad/s, 1 s, came out 37.6 rtol off at
   // rtol 1e-4 (auto's own steps, w_max h ~ 30; the energy check warned) against an explicit Verner
-  // run at rtol 1e-11. Its error went as (w_max h)^6.5 at each rtol and hardly with the swing
-  // (0.05, 1 and 2 times that speed: 0.0019, 0.0020, 0.0044 rtol at w_max h = 3 and rtol 1e-4;
-  // at 0.05 times, the estimates' own steps left 44 rtol at rtol 1e-4 and, held to w_max h
-  // <= 0.1 / (the rotation from the linearization), still 51 at 1e-8: the long steps right after
-  // each relinearization count). So the steps stay below kMechanismStep (rtol /
-  // kMechanismRtol)^(1/6) / w_max, at most kMechanismLongestStep / w_max: 6, 3, 1.4 at rtol 1e-4,
-  // 1e-6, 1e-8.
-  static constexpr double kMechanismStep = 3.0;
-  static constexpr double kMechanismRtol = 1e-6;
-  static constexpr double kMechanismLongestStep = 6.0;
+  // run at rtol 1e-11; its error went as (w_max h)^6.5 and hardly with the swing (0.05, 1 and 2
+  // times that speed: 0.0019, 0.0020, 0.0044 rtol at w_max h = 3). On the bobs of an adversarial
+  // review (2 s, joints of the default compliance, under loads: no energy check) it went as
+  // (w_max h)^3.5 to 4: at rtol 1e-8, 7 to 16 rtol at w_max h = 1.4, 0.35 to 0.96 at 0.7, 0.02 to
+  // 0.15 at 0.35. So the steps stay below kMechanismStep (rtol / kMechanismRtol)^(1/4) / w_max, at
+  // most kMechanismLongestStep / w_max (3, 1.9, 0.6 at rtol 1e-4, 1e-6, 1e-8); but only while the
+  // modes above kMechanismStiffModes w_max hold more than kMechanismStiffShare of the modal energy
+  // (stiff_share: the swing turning into the stiff directions of a stale linearization, and their
+  // ringing). Where the mechanism barely turns against its stiff directions they hold almost
+  // nothing, and the bound would cost much: a 0.5 kg bob hinged 0.2 m below the 1 kg tip of a
+  // cantilever (w_max 3e7 rad/s; a share of 1e-13 to 1e-10 at its steps) took 20,988 steps for 2
+  // s at rtol 1e-4, 0.018 rtol off, and under the bound everywhere used up 10 million. The first
+  // pendulum's share starts each relinearized phase at 1e-13 to 1e-9 and grows to 1e-5: the first
+  // steps of a phase stay long, and it is still 6.8 rtol off at rtol 1e-4 (the energy check
+  // warns there).
+  static constexpr double kMechanismStep = 0.6;
+  static constexpr double kMechanismRtol = 1e-8;
+  static constexpr double kMechanismLongestStep = 3.0;
+  static constexpr double kMechanismStiffModes = 0.3;
+  static constexpr double kMechanismStiffShare = 1e-8;
   // With a harmonic load of frequency f (the highest), the steps stay below kHarmonicStep
   // rtol^(1/4) / (2 pi f): the third-order estimate compares two evaluations at the same time
   // (c = 1/2) and cannot see a load's change within the step, and the second-order one saw too
@@ -690,6 +712,8 @@ class ModalExponential : public Integrator {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
         if (turning_step_ > 0.0) h = std::min(h, turning_step_);
+        if (mechanism_step_ > 0.0 && stiff_share() > kMechanismStiffShare)
+          h = std::min(h, mechanism_step_);
         if (harmonic_step_ > 0.0) h = std::min(h, harmonic_step_);
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
@@ -833,6 +857,8 @@ class ModalExponential : public Integrator {
   // In a turning frame (a floating scene that spins), the longest step: kTurningFrameStep / w of
   // the fastest mode integrated [s]; with a mechanism, at most kMechanismStep's bound; 0: none.
   double turning_step_ = 0.0;
+  // With a mechanism, the longest step while its stiff modes hold energy (kMechanismStep) [s].
+  double mechanism_step_ = 0.0;
   double harmonic_step_ = 0.0;     // with harmonic loads, the longest step (kHarmonicStep) [s]
   double low_order_weight_ = 1.0;  // rtol^(1/4) / kLowOrderScale
 };

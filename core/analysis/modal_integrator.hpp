@@ -35,7 +35,10 @@
 // Accuracy degrades with the size of the motion: past kMaxRotation the run stops with a message
 // naming the body. A part of the scene that floats and spins is followed in a frame turning with it
 // (core/analysis/modal_coordinates.hpp): its rigid spin is no motion away from the linearization
-// there, and the steps stay below min(3, (rtol / 1e-8)^(1/4)) / w_max (kTurningFrameStep).
+// there, and the steps stay below min(3, (rtol / 1e-8)^(1/4)) / w_max (kTurningFrameStep). A
+// mechanism (a body not held by beams and fixed joints to the ground, in no floating part) turns
+// its stiff directions as it moves: its steps stay below min(3, 0.6 (rtol / 1e-8)^(1/4)) / w_max
+// (kMechanismStep) while its stiff modes hold energy.
 //
 // Band-limited (IntegratorOptions::max_frequency_hz): only the m modes up to the band are
 // integrated (from the dense eigensolver, or above kModalIntegratorMaxDofs from shift-invert

@@ -188,6 +188,7 @@ class AutoIntegrator : public Integrator {
         if (!start_implicit(IntegratorMethod::kBdf, "", *t, y, coupled, &error)) return fail(error);
         continue;
       }
+      if (modal_mechanism_bound(*current_)) hold_modal_mechanism_bound(*next);
       next->restart(*t, y);
       band_hz = std::max(band_hz, next->band_hz);
       absorb_inertia();

@@ -120,6 +120,14 @@ bool set_modal_inertia_limit(Integrator& integrator, double drift);
 // The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
 double modal_step_size(const Integrator& integrator);
 
+// Whether a modal integrator's mechanism step bound (kMechanismStep) holds at its accepted state:
+// a mechanism whose stiff modes hold energy.
+bool modal_mechanism_bound(const Integrator& integrator);
+// Makes a modal integrator hold its mechanism step bound from the start, whatever its stiff
+// modes hold: a phase relinearized where the bound held begins with its stiff modes holding
+// almost nothing in the new linearization, and long first steps there count.
+void hold_modal_mechanism_bound(Integrator& integrator);
+
 // The modal integrator for the system in `context`, starting at (t0, y0); the loads are those of
 // t0 in the linearization.
 std::unique_ptr<Integrator> make_modal_integrator(const IntegratorOptions& options,

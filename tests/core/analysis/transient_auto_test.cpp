@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "core/analysis/auto_integrator.hpp"
@@ -323,9 +326,9 @@ std::string swinging_pair(double damping, double compliance) {
 // directions turning with the swing do on long steps. A 1 kg bob 0.5 m below a revolute joint of
 // the default compliance, thrown at 3 m/s and driven by a constant 0.5 N m torque (a load: no
 // energy check), 0.5 s: without the bound 159 rtol off at rtol 1e-4 (5,008 steps) and 26.7 at
-// 1e-6 (17,317), silent. A bob hinged below a cantilever's tip, whose stiff modes hold almost no
-// energy, keeps its long steps: under the bound everywhere (w_max 3e7 rad/s) it took 10 million
-// steps for 2 s.
+// 1e-6 (17,317), silent. The bob hinged below a cantilever's tip of studies/hinged_bob.json, whose
+// stiff modes hold almost no energy, keeps its long steps: under the bound everywhere (w_max 3e7
+// rad/s) it took 10 million steps for 2 s.
 TEST(TransientAuto, AMechanismsStepsStayBelowItsStiffModesBound) {
   const Model model = scene_from_json(R"({
     "gravity": [0, 0, -9.81],
@@ -367,16 +370,12 @@ TEST(TransientAuto, AMechanismsStepsStayBelowItsStiffModesBound) {
     EXPECT_LT(e, 1e-4);
   }
 
-  const Model hinged = scene_from_json(R"({
-    "gravity": [0, -9.81, 0],
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
-    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-4, 1e-4, 1e-4], "position": [1, 0, 0]},
-               {"name": "bob", "mass": 0.5, "inertia": [1e-3, 1e-3, 1e-3], "position": [1, -0.2, 0]}],
-    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10"}],
-    "joints": [{"name": "hinge", "type": "revolute", "body1": "tip", "body2": "bob",
-                "point": [1, 0, 0], "axis": [0, 0, 1]}]})");
+  // studies/hinged_bob.json's scene.
+  std::ifstream file(std::string(BEAMRAIL_STUDIES_DIR) + "/hinged_bob.json");
+  ASSERT_TRUE(file) << "studies/hinged_bob.json";
+  std::stringstream text;
+  text << file.rdbuf();
+  const Model hinged = scene_from_json(nlohmann::json::parse(text.str()).at("scene").dump());
   const TransientRun run = run_with(hinged, "auto", 0.3, 0.01, 1e-6);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   std::printf("bob hinged below a cantilever, auto, rtol 1e-6, 0.3 s: %ld steps, %ld phases\n",

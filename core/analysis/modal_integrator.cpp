@@ -14,6 +14,7 @@
 #include "core/analysis/modal_band.hpp"
 #include "core/analysis/modal_coordinates.hpp"
 #include "core/analysis/modal_reference.hpp"
+#include "core/analysis/modal_step_bounds.hpp"
 #include "core/analysis/quasi_static_modes.hpp"
 #include "core/analysis/static_analysis.hpp"
 #include "core/analysis/transient.hpp"
@@ -27,17 +28,6 @@ namespace beamrail {
 namespace {
 
 constexpr int kD = kDofsPerBody;
-
-// True when a free body moves as a mechanism: not held by beams and fixed joints to the ground
-// (a pendulum on a joint, a carriage on a rail) and not part of a floating part.
-bool moves_as_mechanism(const Model& model) {
-  std::vector<char> floating(model.n_free(), 0);
-  for (const std::vector<int>& part : floating_parts(model))
-    for (int i : part) floating[i] = 1;
-  for (int i : free_bodies_not_held(model))
-    if (!floating[i]) return true;
-  return false;
-}
 
 using Block = ModeBlock;
 
@@ -121,19 +111,10 @@ class ModalExponential : public Integrator {
       *error = "the modal integrator: the damping forces at the linearization are not finite";
       return false;
     }
-    if (blocks_.lambda.size() > 0 && blocks_.lambda.maxCoeff() > 0.0) {
-      const double w_max = std::sqrt(blocks_.lambda.maxCoeff());
-      if (coordinates_.turning())
-        turning_step_ = std::min(kTurningFrameStep * std::pow(o.rtol / kTurningFrameRtol, 0.25),
-                                 kTurningFrameLongestStep) /
-                        w_max;
-      if (moves_as_mechanism(model))
-        mechanism_step_ = std::min(kMechanismStep * std::pow(o.rtol / kMechanismRtol, 0.25),
-                                   kMechanismLongestStep) /
-                          w_max;
-    }
-    if (const double hz = highest_harmonic_hz(model); hz > 0.0)
-      harmonic_step_ = kHarmonicStep * std::pow(o.rtol, 0.25) / (2.0 * std::numbers::pi * hz);
+    bounds_ = ModalStepBounds(
+        o.rtol,
+        blocks_.lambda.size() > 0 ? std::sqrt(std::max(blocks_.lambda.maxCoeff(), 0.0)) : 0.0,
+        coordinates_.turning(), moves_as_mechanism(model), highest_harmonic_hz(model));
     from_states(y);
     linear_solver = "modal";
     band_hz = m_ < n_ ? band_hz_ : 0.0;
@@ -211,24 +192,10 @@ class ModalExponential : public Integrator {
 
   // Whether the mechanism's step bound holds at the accepted state.
   bool mechanism_bound() const {
-    return mechanism_step_ > 0.0 && (hold_mechanism_bound_ || stiff_share() > kMechanismStiffShare);
+    return bounds_.mechanism > 0.0 &&
+           (bounds_.hold_mechanism || modal_stiff_share(blocks_.lambda, z_) > kMechanismStiffShare);
   }
-  void hold_mechanism_bound() { hold_mechanism_bound_ = true; }
-
-  // The share of the modal energy sum 1/2 (zdot_i^2 + lambda_i z_i^2) (from the linearization's
-  // reference) in the modes above kMechanismStiffModes w_max, at the accepted state.
-  double stiff_share() const {
-    const double lambda_max = blocks_.lambda.maxCoeff();
-    const double lambda_stiff = kMechanismStiffModes * kMechanismStiffModes * lambda_max;
-    double total = 0.0, stiff = 0.0;
-    for (int i = 0; i < m_; ++i) {
-      const double lambda = std::max(blocks_.lambda[i], 0.0);
-      const double e = z_(i, 1) * z_(i, 1) + lambda * z_(i, 0) * z_(i, 0);
-      total += e;
-      if (lambda > lambda_stiff) stiff += e;
-    }
-    return total > 0.0 ? stiff / total : 0.0;
-  }
+  void hold_mechanism_bound() { bounds_.hold_mechanism = true; }
 
   std::string failure(int flag) const override {
     if (context_->timed_out) return "timeout: the run exceeded its max_seconds budget";
@@ -642,69 +609,6 @@ class ModalExponential : public Integrator {
   // left 3.0 and 2.9 rtol at 1e-3 against an independent run, 0.54 and 0.71 rtol at 1e-5 (rtol
   // 1e-4, 1e-5; tests/core/analysis/transient_auto_test.cpp).
   static constexpr double kQuasiStaticTolerance = 1e-5;
-  // A floating scene that spins is followed in a frame that turns with it
-  // (modal_coordinates.hpp): its rigid spin then leaves no remainder, but the frame's Coriolis
-  // and gyroscopic accelerations couple every mode's velocity into the others through the
-  // remainder, and the estimates above do not see what that does on long steps: on a free pair
-  // on a steel rod (w_max 2.1e4 rad/s, the rod's axial mode) spinning at 8 rad/s, 3 s, at rtol
-  // 1e-10 (where the estimates hold the steps no more), the error of the centres went as
-  // (w_max h)^4 (1.6e-9, 7.5e-9, 4.0e-8, 2.1e-7 at w_max h = 1, 1.5, 2.25, 3.4), then jumped
-  // (9.9e-6 at 5; in fixed axes a resonance at w h = 2 pi). So the steps stay below
-  // kTurningFrameStep (rtol / kTurningFrameRtol)^(1/4) / w_max, at most kTurningFrameLongestStep
-  // / w_max: that error then follows rtol. Against an explicit Verner run at rtol 1e-11 three
-  // such pairs (1.5 and 8 rad/s about the major axis, 8 along the rod) came out 0.005 .. 1.5 rtol
-  // off over rtol 1e-4 .. 1e-8 (turning_frame_test.cpp; without the bound up to 378 rtol at
-  // 1e-8, and 12 .. 537 rtol in fixed axes: README "Floating scenes turn with their frame").
-  // The constants are fitted to the 8 rad/s pair: a faster spin couples more.
-  static constexpr double kTurningFrameStep = 1.0;
-  static constexpr double kTurningFrameRtol = 1e-8;
-  static constexpr double kTurningFrameLongestStep = 3.0;
-  // A mechanism (a body not held by beams and fixed joints to the ground, in no floating part: a
-  // pendulum on a joint) turns its stiff directions with it too, and the estimates miss the same
-  // thing. A pendulum of a 0.5 kg arm on a revolute joint (relative compliance 1e-3, w_max 1.23e6
-  // rad/s) and a 1 kg bob on a 0.25 m rod, swinging at 4 rad/s, 1 s, came out 37.6 rtol off at
-  // rtol 1e-4 (auto's own steps, w_max h ~ 30; the energy check warned) against an explicit Verner
-  // run at rtol 1e-11; its error went as (w_max h)^6.5 and hardly with the swing (0.05, 1 and 2
-  // times that speed: 0.0019, 0.0020, 0.0044 rtol at w_max h = 3). On the bobs of an adversarial
-  // review (2 s, joints of the default compliance, under loads: no energy check) it went as
-  // (w_max h)^3.5 to 4: at rtol 1e-8, 7 to 16 rtol at w_max h = 1.4, 0.35 to 0.96 at 0.7, 0.02 to
-  // 0.15 at 0.35. So the steps stay below kMechanismStep (rtol / kMechanismRtol)^(1/4) / w_max, at
-  // most kMechanismLongestStep / w_max (3, 1.9, 0.6 at rtol 1e-4, 1e-6, 1e-8); but only while the
-  // modes above kMechanismStiffModes w_max hold more than kMechanismStiffShare of the modal energy
-  // (stiff_share: the swing turning into the stiff directions of a stale linearization, and their
-  // ringing). Where the mechanism barely turns against its stiff directions they hold almost
-  // nothing, and the bound would cost much: a 0.5 kg bob hinged 0.2 m below the 1 kg tip of a
-  // cantilever (w_max 3e7 rad/s; a share of 1e-13 to 1e-10 at its steps) took 20,988 steps for 2
-  // s at rtol 1e-4, 0.018 rtol off, and under the bound everywhere used up 10 million. The first
-  // pendulum's share starts each relinearized phase at 1e-13 to 1e-9 and grows to 1e-5: with
-  // long first steps in each phase it stayed 6.6 rtol off at rtol 1e-4. So a phase relinearized
-  // where the bound held holds it from its start (hold_modal_mechanism_bound, auto): 0.0053 /
-  // 0.0089 / 0.0018 rtol at rtol 1e-4 / 1e-6 / 1e-8.
-  static constexpr double kMechanismStep = 0.6;
-  static constexpr double kMechanismRtol = 1e-8;
-  static constexpr double kMechanismLongestStep = 3.0;
-  static constexpr double kMechanismStiffModes = 0.3;
-  static constexpr double kMechanismStiffShare = 1e-8;
-  // The bound shortens the estimates' step kMechanismMostShorter times at most: where they were
-  // right it costs at most that factor. A flexible arm on a revolute joint of the default
-  // compliance (a 0.1 kg hub, a 0.5 m rod, a 0.5 kg tip; an adversarial review) holds energy in
-  // its stiff modes all along, but its runs without the bound at rtol 1e-6 and 1e-8 agreed with a
-  // bounded one to 1e-6 of the motion; under the bound alone it took 5 million steps for 1 s at
-  // 1e-6 (5,400 without) and ran out of max_steps at 1e-8; at most 10 times shorter, 27k / 43k
-  // / 131k steps at 1e-4 / 1e-6 / 1e-8; at most 100 times, 43k / 427k / 1.3 million. A bob
-  // hanging on such a joint under a 1e-2 N m harmonic torque needs more: its estimates' steps
-  // were far too long (421 / 316 / 1,800 rtol off before the bound), and it came out 41 / 890 /
-  // 33 rtol off at 10 times, 22 / 11 / 14 at 30, 0.004 / 0.07 / 4.0 at 100.
-  static constexpr double kMechanismMostShorter = 100.0;
-  // With a harmonic load of frequency f (the highest), the steps stay below kHarmonicStep
-  // rtol^(1/4) / (2 pi f): the third-order estimate compares two evaluations at the same time
-  // (c = 1/2) and cannot see a load's change within the step, and the second-order one saw too
-  // little of it. A 1 kg tip on a 0.5 m rod of 10 mm under 500 N at 20 Hz (an adversarial
-  // review, 2026-11-29; its centres against Verner at rtol 1e-11, in rtol at rtol 1e-4 / 1e-6
-  // / 1e-8) came out 21 / 60 / 125 rtol off with 769 / 2,010 / 5,381 steps, some of them long
-  // where the estimates missed the load; with 2 pi f h at most 0.25 / 0.079 / 0.025 (this
-  // bound) 0.11 / 0.088 / 0.07, with 1,075 / 3,380 / 10,404 steps.
-  static constexpr double kHarmonicStep = 2.5;
   // A floating part is followed in a turning frame when it turns more than this over the run
   // [rad].
   static constexpr double kTurningFrameMinTurn = 1e-3;
@@ -729,10 +633,7 @@ class ModalExponential : public Integrator {
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
-        if (turning_step_ > 0.0) h = std::min(h, turning_step_);
-        if (mechanism_bound())
-          h = std::min(h, std::max(mechanism_step_, h_ / kMechanismMostShorter));
-        if (harmonic_step_ > 0.0) h = std::min(h, harmonic_step_);
+        h = bounds_.limit(h, h_, mechanism_bound());
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
@@ -872,14 +773,7 @@ class ModalExponential : public Integrator {
   int far_body_ = -1;
   std::string detail_;
   double max_rotation_ = kModalIntegratorMaxRotation;
-  // In a turning frame (a floating scene that spins), the longest step: kTurningFrameStep / w of
-  // the fastest mode integrated [s]; with a mechanism, at most kMechanismStep's bound; 0: none.
-  double turning_step_ = 0.0;
-  // With a mechanism, the longest step while its stiff modes hold energy (kMechanismStep) [s].
-  double mechanism_step_ = 0.0;
-  // The bound from the start, whatever the share (hold_modal_mechanism_bound).
-  bool hold_mechanism_bound_ = false;
-  double harmonic_step_ = 0.0;     // with harmonic loads, the longest step (kHarmonicStep) [s]
+  ModalStepBounds bounds_;         // the longest steps beside the estimates (modal_step_bounds.hpp)
   double low_order_weight_ = 1.0;  // rtol^(1/4) / kLowOrderScale
 };
 

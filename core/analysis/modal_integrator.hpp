@@ -39,7 +39,8 @@
 // mechanism (a body not held by beams and fixed joints to the ground, in no floating part) turns
 // its stiff directions as it moves: its steps stay below min(3, 0.6 (rtol / 1e-8)^(1/4)) / w_max
 // (kMechanismStep) while its stiff modes hold energy, and never 100 times shorter than the
-// estimates' step (kMechanismMostShorter).
+// estimates' step (kMechanismMostShorter). These bounds and their measurements:
+// core/analysis/modal_step_bounds.hpp.
 //
 // Band-limited (IntegratorOptions::max_frequency_hz): only the m modes up to the band are
 // integrated (from the dense eigensolver, or above kModalIntegratorMaxDofs from shift-invert

@@ -88,7 +88,7 @@ TEST(LoadSampling, APulseBetweenTheOutputsMovesTheTipWhateverTheMethod) {
 // A 100 Hz load of 1 kN, outputs every 0.01 s: auto took one step per output and its stages
 // (at 0, h/2 and h) met the sine at its zeros only; the tip stayed at rest at every rtol (an
 // error of 1e4 .. 1e8 rtol). No step is now longer than 1 / (2 pi f) (transient.cpp), and the
-// modal method's no longer than 2.5 rtol^(1/4) / (2 pi f) (modal_integrator.cpp,
+// modal method's no longer than 2.5 rtol^(1/4) / (2 pi f) (modal_step_bounds.hpp,
 // kHarmonicStep): with the first bound alone 9.6 / 24 / 40 rtol at rtol 1e-4 / 1e-6 / 1e-8.
 TEST(LoadSampling, AHarmonicLoadInStepWithTheOutputsIsSampled) {
   const double f = 100.0, t_end = 0.5;

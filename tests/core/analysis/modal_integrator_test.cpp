@@ -362,7 +362,7 @@ TEST(ModalIntegrator, StopsWithAMessageWhenABodyTurnsTooFar) {
     EXPECT_NEAR(rotation_vector(s.pose[b].A).z(), 2.2 * s.sample.t, 1e-12) << s.sample.t;
   // It stops at its last accepted step within the limit: from the last sample on, before 1 rad
   // (where that step ends depends on the step sizes: a mechanism's are bounded while its stiff
-  // modes hold energy, kMechanismStep in modal_integrator.cpp).
+  // modes hold energy, kMechanismStep in modal_step_bounds.hpp).
   EXPECT_GE(run.result.t_reached, 0.4);
   EXPECT_LT(run.result.t_reached, 1.0 / 2.2);
 }

@@ -322,7 +322,7 @@ std::string swinging_pair(double damping, double compliance) {
 }
 
 // A mechanism's steps stay below a bound in its fastest mode while its stiff modes hold energy
-// (kMechanismStep, core/analysis/modal_integrator.cpp): the estimates do not see what the stiff
+// (kMechanismStep, core/analysis/modal_step_bounds.hpp): the estimates do not see what the stiff
 // directions turning with the swing do on long steps. A 1 kg bob 0.5 m below a revolute joint of
 // the default compliance, thrown at 3 m/s and driven by a constant 0.5 N m torque (a load: no
 // energy check), 0.5 s: without the bound 159 rtol off at rtol 1e-4 (5,008 steps) and 26.7 at

@@ -254,7 +254,7 @@ TEST(TurningFrame, SpinningPairsFollowTheirTolerance) {
   }
 }
 
-// The turning frame's step bound (modal_integrator.cpp, kTurningFrameStep) was fitted to the pair
+// The turning frame's step bound (core/analysis/modal_step_bounds.hpp, kTurningFrameStep) was fitted to the pair
 // at 8 rad/s, and a faster spin couples the modes more through the frame's Coriolis and
 // gyroscopic terms, which the error estimates do not see: measured with free runs of main at
 // 01c0cf5 (the pair's centres over 0.3 s against Verner at rtol 1e-12; in rtol at rtol 1e-4 / 1e-6

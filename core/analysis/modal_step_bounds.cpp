@@ -1,0 +1,57 @@
+#include "core/analysis/modal_step_bounds.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "core/analysis/modal_coordinates.hpp"
+
+namespace beamrail {
+
+bool moves_as_mechanism(const Model& model) {
+  std::vector<char> floating(model.n_free(), 0);
+  for (const std::vector<int>& part : floating_parts(model))
+    for (int i : part) floating[i] = 1;
+  for (int i : free_bodies_not_held(model))
+    if (!floating[i]) return true;
+  return false;
+}
+
+double modal_stiff_share(const Eigen::ArrayXd& lambda, const ModeBlock& z) {
+  if (lambda.size() == 0) return 0.0;
+  const double lambda_stiff = kMechanismStiffModes * kMechanismStiffModes * lambda.maxCoeff();
+  double total = 0.0, stiff = 0.0;
+  for (Eigen::Index i = 0; i < lambda.size(); ++i) {
+    const double l = std::max(lambda[i], 0.0);
+    const double e = z(i, 1) * z(i, 1) + l * z(i, 0) * z(i, 0);
+    total += e;
+    if (l > lambda_stiff) stiff += e;
+  }
+  return total > 0.0 ? stiff / total : 0.0;
+}
+
+ModalStepBounds::ModalStepBounds(double rtol, double w_max, bool turning_frame,
+                                 bool mechanism_moves, double harmonic_hz) {
+  if (w_max > 0.0) {
+    if (turning_frame)
+      turning = std::min(kTurningFrameStep * std::pow(rtol / kTurningFrameRtol, 0.25),
+                         kTurningFrameLongestStep) /
+                w_max;
+    if (mechanism_moves)
+      mechanism =
+          std::min(kMechanismStep * std::pow(rtol / kMechanismRtol, 0.25), kMechanismLongestStep) /
+          w_max;
+  }
+  if (harmonic_hz > 0.0)
+    harmonic = kHarmonicStep * std::pow(rtol, 0.25) / (2.0 * std::numbers::pi * harmonic_hz);
+}
+
+double ModalStepBounds::limit(double h, double estimates, bool mechanism_holds) const {
+  if (turning > 0.0) h = std::min(h, turning);
+  if (mechanism_holds) h = std::min(h, std::max(mechanism, estimates / kMechanismMostShorter));
+  if (harmonic > 0.0) h = std::min(h, harmonic);
+  return h;
+}
+
+}  // namespace beamrail

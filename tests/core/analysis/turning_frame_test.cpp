@@ -254,11 +254,11 @@ TEST(TurningFrame, SpinningPairsFollowTheirTolerance) {
   }
 }
 
-// The turning frame's step bound (core/analysis/modal_step_bounds.hpp, kTurningFrameStep) was fitted to the pair
-// at 8 rad/s, and a faster spin couples the modes more through the frame's Coriolis and
-// gyroscopic terms, which the error estimates do not see: measured with free runs of main at
-// 01c0cf5 (the pair's centres over 0.3 s against Verner at rtol 1e-12; in rtol at rtol 1e-4 / 1e-6
-// / 1e-8), 150 rad/s 2.0 / 0.47 / 0.48, 300 rad/s 0.13 / 2.4 / 0.72 (0.59 at 1e-10), the rod
+// The turning frame's step bound (core/analysis/modal_step_bounds.hpp, kTurningFrameStep) was
+// fitted to the pair at 8 rad/s, and a faster spin couples the modes more through the frame's
+// Coriolis and gyroscopic terms, which the error estimates do not see: measured with free runs of
+// main at 01c0cf5 (the pair's centres over 0.3 s against Verner at rtol 1e-12; in rtol at rtol 1e-4
+// / 1e-6 / 1e-8), 150 rad/s 2.0 / 0.47 / 0.48, 300 rad/s 0.13 / 2.4 / 0.72 (0.59 at 1e-10), the rod
 // twice as thick (w_max doubled) at 80 and 150 rad/s 0.12 / 0.16 / 0.15 and 3.1 / 0.43 / 0.19;
 // at 600 rad/s (the ends at 90 m/s) 4.7 / 4.6 / 9.0, near the edge. So the bound holds to 300
 // rad/s, 40 times the spin it was fitted to; this pins it there.

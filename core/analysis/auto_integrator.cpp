@@ -8,6 +8,7 @@
 #include "core/analysis/explicit_stability.hpp"
 #include "core/analysis/modal_coordinates.hpp"
 #include "core/analysis/modal_integrator.hpp"
+#include "core/analysis/modal_step_bounds.hpp"
 #include "core/model/element_kinds.hpp"
 
 namespace beamrail {
@@ -46,19 +47,18 @@ class AutoIntegrator : public Integrator {
     sunctx_ = sunctx;
     const Model& model = c.model;
     if (model.n_free() == 0)
-      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, "the scene has no free body",
-                            error);
+      return start_method(IntegratorMethod::kBdf, "", 0.0, y0, "the scene has no free body", error);
     // A moving support leaves any one linearization: an A-stable implicit method, whose steps the
     // undamped axial modes of a spinning beam do not hold down. On studies/spin_up.json (10
     // segments, 30 s, rtol 1e-7) bdf took 582k steps (13.4 s: its higher orders are unstable for
     // them), ESDIRK547 45k (4.9 s, 6e-5 off a tight run), the default DIRK table 12k (3.2 s, 1e-7
     // off).
     if (!model.driven_bodies.empty())
-      return start_implicit(IntegratorMethod::kDirk, "", 0.0, y0,
-                            "body \"" + model.bodies[model.driven_bodies.front()].name +
-                                "\" moves as prescribed: its supports move, no one configuration "
-                                "to vibrate about",
-                            error);
+      return start_method(IntegratorMethod::kDirk, "", 0.0, y0,
+                          "body \"" + model.bodies[model.driven_bodies.front()].name +
+                              "\" moves as prescribed: its supports move, no one configuration "
+                              "to vibrate about",
+                          error);
     // A damped grounded mechanism (a pendulum on a joint, a carriage on a rail: a body not held by
     // beams and fixed joints to the ground, and no floating part): bdf, as before the modal
     // method's damping was exact. Along a mechanism's large motion the relinearized modal phases'
@@ -70,11 +70,11 @@ class AutoIntegrator : public Integrator {
     // (relinearized, or followed in a turning frame) keep the modal method: there bdf drifts (a
     // damped tumbling pair 10 to 18 rtol, the modal method 0.04 to 0.8).
     if (largest_damping(model) > 0.0 && !held_by_beams(model) && floating_parts(model).empty())
-      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
-                            "damping, and bodies that move as a mechanism (not held by beams and "
-                            "fixed joints to the ground): along a mechanism's large motion the "
-                            "modal method's relinearized phases have no check under damping",
-                            error);
+      return start_method(IntegratorMethod::kBdf, "", 0.0, y0,
+                          "damping, and bodies that move as a mechanism (not held by beams and "
+                          "fixed joints to the ground): along a mechanism's large motion the "
+                          "modal method's relinearized phases have no check under damping",
+                          error);
     choose_band_ =
         !(o.max_frequency_hz > 0.0) && (o.choose_band || model.n_dofs >= kAutoChosenBandDofs);
     // A small scene's eigenproblem is cheap: relinearize sooner from the start.
@@ -90,8 +90,8 @@ class AutoIntegrator : public Integrator {
         *error = why;
         return false;
       }
-      return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0,
-                            "the modal method could not start: " + why, error);
+      return start_method(IntegratorMethod::kBdf, "", 0.0, y0,
+                          "the modal method could not start: " + why, error);
     }
     std::string reason = std::to_string(model.n_free()) + " free bod" +
                          (model.n_free() == 1 ? "y" : "ies") +
@@ -99,7 +99,7 @@ class AutoIntegrator : public Integrator {
     if (double own = 0.0, coupling = 0.0; modal_damping(*modal, &own, &coupling) && own > 0.0) {
       // Each mode's own damping is exact in its block; what couples the modes stays explicit.
       if (const std::string why = coupled_damping(*modal); !why.empty())
-        return start_implicit(IntegratorMethod::kBdf, "", 0.0, y0, why, error);
+        return start_method(IntegratorMethod::kBdf, "", 0.0, y0, why, error);
       const double step = coupling > 0.0 ? 2.5 / coupling : 0.0;
       reason += "; each mode's damping exact (up to " + number(own) + " 1/s)";
       if (step > 0.0)
@@ -113,6 +113,8 @@ class AutoIntegrator : public Integrator {
     for (const std::string& w : modal->warnings) warnings.push_back(w);
     const bool about_initial = o.about == "initial" || !modal->warnings.empty();
     band_hz = modal->band_hz;
+    mechanism_ =
+        moves_as_mechanism(model) && floating_parts(model).empty() && !(o.max_frequency_hz > 0.0);
     limit_inertia(*modal);
     current_ = std::move(modal);
     modal_ = true;
@@ -133,8 +135,8 @@ class AutoIntegrator : public Integrator {
         // not converge): the run goes on from the last accepted state, and says why.
         before_ = sum(before_, current_->stats());
         std::string error;
-        if (!start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
-                            "the modal method failed (" + current_->failure(flag) + ")", &error))
+        if (!start_method(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
+                          "the modal method failed (" + current_->failure(flag) + ")", &error))
           return fail(error);
         continue;
       }
@@ -145,6 +147,12 @@ class AutoIntegrator : public Integrator {
       if (flag != kModalTooFar || !modal_) return flag;
       const std::string who = quoted(current_->failure(flag));
       const long steps = current_->stats().steps;
+      if (const std::string why = explicit_instead(*t, steps); !why.empty()) {
+        before_ = sum(before_, current_->stats());
+        std::string error;
+        if (!start_method(IntegratorMethod::kErk, "", *t, y, why, &error)) return fail(error);
+        continue;
+      }
       short_runs_ = steps < kAutoMinStepsPerLinearization ? short_runs_ + 1 : 0;
       before_ = sum(before_, current_->stats());
       const double turned = rotation_limit_;
@@ -156,10 +164,10 @@ class AutoIntegrator : public Integrator {
         short_runs_ = 0;
       } else if (short_runs_ >= 3) {
         std::string error;
-        if (!start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
-                            "relinearizing every " + std::to_string(steps) + " steps (body " + who +
-                                " turns " + number(rotation_limit_) + " rad that fast)",
-                            &error))
+        if (!start_method(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
+                          "relinearizing every " + std::to_string(steps) + " steps (body " + who +
+                              " turns " + number(rotation_limit_) + " rad that fast)",
+                          &error))
           return fail(error);
         continue;
       }
@@ -177,15 +185,15 @@ class AutoIntegrator : public Integrator {
       if (!next) {
         if (context_->timed_out || context_->interrupted) return fail(why);
         std::string error;
-        if (!start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
-                            "the modal method could not relinearize: " + why, &error))
+        if (!start_method(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
+                          "the modal method could not relinearize: " + why, &error))
           return fail(error);
         continue;
       }
       if (const std::string coupled = coupled_damping(*next); !coupled.empty()) {
         // Relinearized where damping couples the modes more (a deformed structure).
         std::string error;
-        if (!start_implicit(IntegratorMethod::kBdf, "", *t, y, coupled, &error)) return fail(error);
+        if (!start_method(IntegratorMethod::kBdf, "", *t, y, coupled, &error)) return fail(error);
         continue;
       }
       if (modal_mechanism_bound(*current_)) hold_modal_mechanism_bound(*next);
@@ -194,6 +202,7 @@ class AutoIntegrator : public Integrator {
       absorb_inertia();
       limit_inertia(*next);
       current_ = std::move(next);
+      phase_start_ = *t;
       record(*t, "modal",
              "body " + who + " turned " + number(turned) + " rad from the linearization" +
                  (modal_frame_rate(*current_) > 0.0 ? " (in the frame turning with its part)"
@@ -243,6 +252,24 @@ class AutoIntegrator : public Integrator {
            " of the fastest mode's critical damping; the modes' own is exact) would hold the "
            "modal method's steps below " +
            number(2.5 / coupling) + " s; bdf steps over the decayed modes";
+  }
+
+  // Why an explicit Runge-Kutta method goes on from t, when the modal phase that ended there
+  // (`steps` steps, every mode integrated) moved a mechanism with steps its error estimates held
+  // below kAutoExplicitResolved of the mechanism's bound (modal_step_bounds.hpp); else "".
+  std::string explicit_instead(double t, long steps) const {
+    if (!mechanism_ || !(steps > 0) || current_->band_hz > 0.0) return "";
+    double lowest = 0.0, highest = 0.0;
+    if (!modal_spectrum(*current_, &lowest, &highest) || !(highest > 0.0)) return "";
+    const double wh = std::sqrt(highest) * (t - phase_start_) / static_cast<double>(steps);
+    const double bound = mechanism_step_bound(options_.rtol);
+    if (!(wh < kAutoExplicitResolved * bound)) return "";
+    return "a mechanism whose modal steps resolve its fastest mode (" + number(std::sqrt(highest)) +
+           " rad/s times the steps from t = " + number(phase_start_) + " s: " + number(wh) +
+           " on average, the bound at rtol " + number(bound) +
+           "): an explicit Runge-Kutta method is not held shorter by it, and "
+           "its error follows rtol along a mechanism's large motion, where the modal method's "
+           "estimates were measured to miss it";
   }
 
   IntegratorOptions modal_options() const {
@@ -296,9 +323,9 @@ class AutoIntegrator : public Integrator {
     std::unique_ptr<Integrator> next = make_modal_integrator(m, *context_, y, &error, t);
     if (!next) {
       if (!context_->timed_out && !context_->interrupted &&
-          start_implicit(IntegratorMethod::kDirk, kAutoImplicitTable, t, y,
-                         why + "; the modal method with more modes could not start: " + error,
-                         &error))
+          start_method(IntegratorMethod::kDirk, kAutoImplicitTable, t, y,
+                       why + "; the modal method with more modes could not start: " + error,
+                       &error))
         return true;
       fail(error);
       return false;
@@ -308,6 +335,7 @@ class AutoIntegrator : public Integrator {
     absorb_inertia();
     limit_inertia(*next);
     current_ = std::move(next);
+    phase_start_ = t;
     record(t, "modal",
            why +
                (every ? ": every mode integrated from here"
@@ -326,9 +354,9 @@ class AutoIntegrator : public Integrator {
     return kAutoFailed;
   }
 
-  // Goes on with an implicit method from (t, y).
-  bool start_implicit(IntegratorMethod method, const std::string& table, double t, N_Vector y,
-                      const std::string& reason, std::string* error) {
+  // Goes on with another method (bdf, dirk, erk) from (t, y).
+  bool start_method(IntegratorMethod method, const std::string& table, double t, N_Vector y,
+                    const std::string& reason, std::string* error) {
     IntegratorOptions o = options_;
     o.method = method;
     o.table = table;
@@ -365,6 +393,8 @@ class AutoIntegrator : public Integrator {
   SUNContext sunctx_ = nullptr;
   std::unique_ptr<Integrator> current_;
   bool modal_ = false;
+  bool mechanism_ = false;    // a grounded mechanism, no floating part (explicit_instead)
+  double phase_start_ = 0.0;  // where the current modal phase started [s]
   bool choose_band_ = false;  // the modal method's band chosen for rtol
   bool widened_ = false;      // a chosen band was widened (widen_band): to widened_hz_
   double widened_hz_ = 0.0;   // [Hz]; 0: every mode

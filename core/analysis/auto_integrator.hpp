@@ -12,10 +12,12 @@
 //   the current state (one eigenproblem) and the run goes on; when that happens more often than
 //   every kAutoMinStepsPerLinearization steps (a body spinning fast: relinearizing costs more than
 //   it saves), the rest of the run is integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps
-//   the fast modes it does not resolve). In a part of the scene that floats and spins the rotation
-//   counts from a reference turning with that part (core/analysis/modal_coordinates.hpp). A
-//   damped grounded mechanism (damping, a body not held by beams, no floating part) runs bdf
-//   from the start (no energy check backs relinearized modal phases there; auto_integrator.cpp).
+//   the fast modes it does not resolve). A grounded mechanism whose modal steps already resolve
+//   its fastest mode (kAutoExplicitResolved) goes on with erk instead. In a part of the scene that
+//   floats and spins the rotation counts from a reference turning with that part
+//   (core/analysis/modal_coordinates.hpp). A damped grounded mechanism (damping, a body not held by
+//   beams, no floating part) runs bdf from the start (no energy check backs relinearized modal
+//   phases there; auto_integrator.cpp).
 //
 // - A band it chose itself (for rtol) is widened when the inertia of the modes it keeps
 //   quasi-static (their motion at second order: core/analysis/modal_integrator.hpp,
@@ -61,6 +63,24 @@ inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
 // strength: there bdf was 8 to 161 rtol off on the lightly damped cantilevers of an adversarial
 // review (2026-11-29), the modal method within 1 rtol (README "Damped modes exact").
 inline constexpr double kAutoMaxDampingRatio = 0.1;
+
+// A grounded mechanism (a body not held by beams and fixed joints, no floating part, every mode
+// integrated) whose modal phase took steps below this share of the mechanism's bound on w_max h
+// (core/analysis/modal_step_bounds.hpp) goes on with erk (Dormand-Prince 5(4)) from the end of
+// that phase: its steps already resolve the fastest mode, so an explicit method's stability does
+// not hold it shorter, and along a mechanism's large motion the modal method's estimates were
+// measured to miss its error where erk's did not. On two adversarial reviews' 34 mechanisms
+// (2026-11-29; 2 s or 0.5 s, rtol 1e-4 / 1e-6 / 1e-8, the centres against Verner 8(7) at rtol
+// 1e-11): a top on a spherical joint spinning at 30 rad/s (w_max 1.9e4 rad/s; the modal phases
+// at 0.41 / 0.24 / 0.27 of the bound) 10 / 54 / 62 rtol off with the modal method, 0.12 / 0.19 /
+// 0.24 with erk (2.6 times the steps); a pendulum on a spherical joint 0.61 / 4.2 / 0.86, then
+// 0.86 / 0.027 / 0.033 (2.5 times the steps); a chain of three on spherical joints 0.54 / 1.2 /
+// 0.69, then 0.38 / 0.027 / 0.024. The others' phases were at 0.54 to 1 of the bound and keep
+// the modal method: erk took 4 times their steps at rtol 1e-8 (a hinged arm, w_max 9.9e4 rad/s:
+// 1.4 million against 346k, 0.03 and 0.25 rtol) and ran out of max_steps on a joint of
+// compliance 1e-6. With every mechanism's phase under w_max h = 1.5 going on with erk, a
+// double pendulum came out 21.5 rtol off at rtol 1e-6 (the modal method 6.8).
+inline constexpr double kAutoExplicitResolved = 0.45;
 
 // From this many degrees of freedom on, auto chooses the modal method's band for rtol
 // (IntegratorOptions::choose_band) unless one is given: the modes whose ringing the run can show

@@ -9,6 +9,10 @@
 
 namespace beamrail {
 
+double mechanism_step_bound(double rtol) {
+  return std::min(kMechanismStep * std::pow(rtol / kMechanismRtol, 0.25), kMechanismLongestStep);
+}
+
 bool moves_as_mechanism(const Model& model) {
   std::vector<char> floating(model.n_free(), 0);
   for (const std::vector<int>& part : floating_parts(model))
@@ -38,10 +42,7 @@ ModalStepBounds::ModalStepBounds(double rtol, double w_max, bool turning_frame,
       turning = std::min(kTurningFrameStep * std::pow(rtol / kTurningFrameRtol, 0.25),
                          kTurningFrameLongestStep) /
                 w_max;
-    if (mechanism_moves)
-      mechanism =
-          std::min(kMechanismStep * std::pow(rtol / kMechanismRtol, 0.25), kMechanismLongestStep) /
-          w_max;
+    if (mechanism_moves) mechanism = mechanism_step_bound(rtol) / w_max;
   }
   if (harmonic_hz > 0.0)
     harmonic = kHarmonicStep * std::pow(rtol, 0.25) / (2.0 * std::numbers::pi * harmonic_hz);

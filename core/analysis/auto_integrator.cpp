@@ -113,8 +113,7 @@ class AutoIntegrator : public Integrator {
     for (const std::string& w : modal->warnings) warnings.push_back(w);
     const bool about_initial = o.about == "initial" || !modal->warnings.empty();
     band_hz = modal->band_hz;
-    mechanism_ =
-        moves_as_mechanism(model) && floating_parts(model).empty() && !(o.max_frequency_hz > 0.0);
+    mechanism_ = moves_as_mechanism(model) && !(o.max_frequency_hz > 0.0);
     limit_inertia(*modal);
     current_ = std::move(modal);
     modal_ = true;
@@ -150,7 +149,8 @@ class AutoIntegrator : public Integrator {
       if (const std::string why = explicit_instead(*t, steps); !why.empty()) {
         before_ = sum(before_, current_->stats());
         std::string error;
-        if (!start_method(IntegratorMethod::kErk, "", *t, y, why, &error)) return fail(error);
+        if (!start_method(IntegratorMethod::kErk, kAutoExplicitTable, *t, y, why, &error))
+          return fail(error);
         continue;
       }
       short_runs_ = steps < kAutoMinStepsPerLinearization ? short_runs_ + 1 : 0;
@@ -255,21 +255,27 @@ class AutoIntegrator : public Integrator {
   }
 
   // Why an explicit Runge-Kutta method goes on from t, when the modal phase that ended there
-  // (`steps` steps, every mode integrated) moved a mechanism with steps its error estimates held
-  // below kAutoExplicitResolved of the mechanism's bound (modal_step_bounds.hpp); else "".
+  // (`steps` steps, every mode integrated) moved a mechanism, or a part followed in a turning
+  // frame, with steps its error estimates held below kAutoExplicitResolved of the bound on
+  // w_max h there (core/analysis/modal_step_bounds.hpp); else "".
   std::string explicit_instead(double t, long steps) const {
-    if (!mechanism_ || !(steps > 0) || current_->band_hz > 0.0) return "";
+    if (!(steps > 0) || current_->band_hz > 0.0) return "";
+    const bool turning = modal_frame_rate(*current_) > 0.0;
+    if (!mechanism_ && !turning) return "";
     double lowest = 0.0, highest = 0.0;
     if (!modal_spectrum(*current_, &lowest, &highest) || !(highest > 0.0)) return "";
     const double wh = std::sqrt(highest) * (t - phase_start_) / static_cast<double>(steps);
-    const double bound = mechanism_step_bound(options_.rtol);
+    double bound = std::numeric_limits<double>::infinity();
+    if (mechanism_) bound = mechanism_step_bound(options_.rtol);
+    if (turning) bound = std::min(bound, turning_step_bound(options_.rtol));
     if (!(wh < kAutoExplicitResolved * bound)) return "";
-    return "a mechanism whose modal steps resolve its fastest mode (" + number(std::sqrt(highest)) +
+    return std::string(mechanism_ ? "a mechanism" : "a part turning with its frame") +
+           " whose modal steps resolve its fastest mode (" + number(std::sqrt(highest)) +
            " rad/s times the steps from t = " + number(phase_start_) + " s: " + number(wh) +
            " on average, the bound at rtol " + number(bound) +
-           "): an explicit Runge-Kutta method is not held shorter by it, and "
-           "its error follows rtol along a mechanism's large motion, where the modal method's "
-           "estimates were measured to miss it";
+           "): an explicit Runge-Kutta method is not held shorter by it, and its error follows "
+           "rtol along the large motion, where the modal method's estimates were measured to "
+           "miss it";
   }
 
   IntegratorOptions modal_options() const {
@@ -393,7 +399,7 @@ class AutoIntegrator : public Integrator {
   SUNContext sunctx_ = nullptr;
   std::unique_ptr<Integrator> current_;
   bool modal_ = false;
-  bool mechanism_ = false;    // a grounded mechanism, no floating part (explicit_instead)
+  bool mechanism_ = false;    // a body moves as a mechanism, no band of the user's
   double phase_start_ = 0.0;  // where the current modal phase started [s]
   bool choose_band_ = false;  // the modal method's band chosen for rtol
   bool widened_ = false;      // a chosen band was widened (widen_band): to widened_hz_

@@ -12,8 +12,9 @@
 //   the current state (one eigenproblem) and the run goes on; when that happens more often than
 //   every kAutoMinStepsPerLinearization steps (a body spinning fast: relinearizing costs more than
 //   it saves), the rest of the run is integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps
-//   the fast modes it does not resolve). A grounded mechanism whose modal steps already resolve
-//   its fastest mode (kAutoExplicitResolved) goes on with erk instead. In a part of the scene that
+//   the fast modes it does not resolve). A mechanism, or a part followed in a turning frame,
+//   whose modal steps already resolve its fastest mode goes on with erk instead
+//   (kAutoExplicitResolved). In a part of the scene that
 //   floats and spins the rotation counts from a reference turning with that part
 //   (core/analysis/modal_coordinates.hpp). A damped grounded mechanism (damping, a body not held by
 //   beams, no floating part) runs bdf from the start (no energy check backs relinearized modal
@@ -64,23 +65,32 @@ inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
 // review (2026-11-29), the modal method within 1 rtol (README "Damped modes exact").
 inline constexpr double kAutoMaxDampingRatio = 0.1;
 
-// A grounded mechanism (a body not held by beams and fixed joints, no floating part, every mode
-// integrated) whose modal phase took steps below this share of the mechanism's bound on w_max h
-// (core/analysis/modal_step_bounds.hpp) goes on with erk (Dormand-Prince 5(4)) from the end of
-// that phase: its steps already resolve the fastest mode, so an explicit method's stability does
-// not hold it shorter, and along a mechanism's large motion the modal method's estimates were
-// measured to miss its error where erk's did not. On two adversarial reviews' 34 mechanisms
-// (2026-11-29; 2 s or 0.5 s, rtol 1e-4 / 1e-6 / 1e-8, the centres against Verner 8(7) at rtol
-// 1e-11): a top on a spherical joint spinning at 30 rad/s (w_max 1.9e4 rad/s; the modal phases
-// at 0.41 / 0.24 / 0.27 of the bound) 10 / 54 / 62 rtol off with the modal method, 0.12 / 0.19 /
-// 0.24 with erk (2.6 times the steps); a pendulum on a spherical joint 0.61 / 4.2 / 0.86, then
-// 0.86 / 0.027 / 0.033 (2.5 times the steps); a chain of three on spherical joints 0.54 / 1.2 /
-// 0.69, then 0.38 / 0.027 / 0.024. The others' phases were at 0.54 to 1 of the bound and keep
-// the modal method: erk took 4 times their steps at rtol 1e-8 (a hinged arm, w_max 9.9e4 rad/s:
-// 1.4 million against 346k, 0.03 and 0.25 rtol) and ran out of max_steps on a joint of
-// compliance 1e-6. With every mechanism's phase under w_max h = 1.5 going on with erk, a
-// double pendulum came out 21.5 rtol off at rtol 1e-6 (the modal method 6.8).
+// A modal phase (every mode integrated) that moved a mechanism (a body not held by beams and
+// fixed joints to the ground) or a part followed in a turning frame, with steps its error
+// estimates held below this share of the bound on w_max h there (kMechanismStep, kTurningFrameStep
+// in core/analysis/modal_step_bounds.hpp; the smaller when both apply), goes on with erk
+// kAutoExplicitTable from the end of that phase: its steps already resolve the fastest mode, so
+// an explicit method's stability does not hold it shorter, and along such large motions the
+// modal method's estimates were measured to miss its error where the explicit method's did not.
+// On two adversarial reviews' 34 grounded mechanisms (2026-11-29; 2 s or 0.5 s, rtol 1e-4 / 1e-6
+// / 1e-8, the centres against Verner 8(7) at rtol 1e-11, in rtol): a top on a spherical joint
+// spinning at 30 rad/s (w_max 1.9e4 rad/s; its phases at 0.41 / 0.24 / 0.27 of the bound) 10 /
+// 54 / 62 with the modal method, 0.013 / 0.017 / 0.030 with Verner (2 to 2.5 times the steps;
+// Dormand-Prince 5(4) 0.12 / 0.19 / 0.24 in more); a pendulum on a spherical joint 0.61 / 4.2 /
+// 0.86, then 0.86 / 0.008 / 0.002; a chain of three on spherical joints 0.54 / 1.2 / 0.69, then
+// 0.38 / 0.0012 / 0.0009. The others' phases were at 0.54 to 1 of the bound and keep the modal
+// method: where the bound holds a pendulum's steps erk resolves its stiff ringing itself, and
+// Dormand-Prince took 4 times their steps at rtol 1e-8 (a hinged arm, w_max 9.9e4 rad/s: 1.4
+// million against 346k, 0.03 and 0.25 rtol) and ran out of max_steps on a joint of compliance
+// 1e-6. With every mechanism's phase under w_max h = 1.5 going on with Dormand-Prince, a double
+// pendulum came out 21.5 rtol off at rtol 1e-6 (the modal method 6.8). Floating: the tumbling
+// pair of tests/benchmarks/transient_auto, 10 s, 0.066 / 0.059 / 0.044 rtol at rtol 1e-6 / 1e-8
+// / 1e-10 in 0.51 / 0.99 / 1.98 s (the modal method 0.88 / 1.2 / 1.6 rtol in 0.49 / 1.1 / 3.8 s;
+// bdf 1.7 / 15 / 37 rtol in 0.58 / 1.9 / 3.7 s); a pair on a 20 mm rod spinning at 300 rad/s, 1
+// s, 4.3 / 25 / 29 rtol at rtol 1e-4 / 1e-6 / 1e-8, then 2.1 / 8.2 / 3.8.
 inline constexpr double kAutoExplicitResolved = 0.45;
+// The explicit method auto hands over to (kAutoExplicitResolved).
+inline constexpr const char* kAutoExplicitTable = "VERNER_8_5_6";
 
 // From this many degrees of freedom on, auto chooses the modal method's band for rtol
 // (IntegratorOptions::choose_band) unless one is given: the modes whose ringing the run can show

@@ -9,6 +9,11 @@
 
 namespace beamrail {
 
+double turning_step_bound(double rtol) {
+  return std::min(kTurningFrameStep * std::pow(rtol / kTurningFrameRtol, 0.25),
+                  kTurningFrameLongestStep);
+}
+
 double mechanism_step_bound(double rtol) {
   return std::min(kMechanismStep * std::pow(rtol / kMechanismRtol, 0.25), kMechanismLongestStep);
 }
@@ -38,10 +43,7 @@ double modal_stiff_share(const Eigen::ArrayXd& lambda, const ModeBlock& z) {
 ModalStepBounds::ModalStepBounds(double rtol, double w_max, bool turning_frame,
                                  bool mechanism_moves, double harmonic_hz) {
   if (w_max > 0.0) {
-    if (turning_frame)
-      turning = std::min(kTurningFrameStep * std::pow(rtol / kTurningFrameRtol, 0.25),
-                         kTurningFrameLongestStep) /
-                w_max;
+    if (turning_frame) turning = turning_step_bound(rtol) / w_max;
     if (mechanism_moves) mechanism = mechanism_step_bound(rtol) / w_max;
   }
   if (harmonic_hz > 0.0)

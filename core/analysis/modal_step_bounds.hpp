@@ -72,6 +72,10 @@ inline constexpr double kMechanismMostShorter = 100.0;
 // bound) 0.11 / 0.088 / 0.07, with 1,075 / 3,380 / 10,404 steps.
 inline constexpr double kHarmonicStep = 2.5;
 
+// The turning frame's bound on w_max h at `rtol`: kTurningFrameStep (rtol /
+// kTurningFrameRtol)^(1/4), at most kTurningFrameLongestStep.
+double turning_step_bound(double rtol);
+
 // The mechanism's bound on w_max h at `rtol`: kMechanismStep (rtol / kMechanismRtol)^(1/4), at
 // most kMechanismLongestStep.
 double mechanism_step_bound(double rtol);

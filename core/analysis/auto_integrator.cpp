@@ -370,7 +370,7 @@ class AutoIntegrator : public Integrator {
     o.max_frequency_hz = 0.0;
     o.choose_band = false;
     o.max_rotation = 0.0;
-    o.max_steps = std::max(1L, options_.max_steps - before_.steps);
+    o.steps_before = before_.steps;
     std::unique_ptr<Integrator> next = make_integrator(o, *context_, sunctx_, y, error);
     if (!next) return false;
     if (t > 0.0) next->restart(t, y);

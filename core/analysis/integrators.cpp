@@ -138,7 +138,7 @@ class SundialsIntegrator : public Integrator {
   }
   std::string failure(int flag) const final {
     std::string why = explain(flag, package_, flag < 0 && flag != kNonFiniteState ? name(flag) : "",
-                              messages_.last, *context_, max_steps_);
+                              messages_.last, *context_, run_max_steps_);
     if (fixed_step_ && !context_->interrupted && !context_->timed_out)
       why += flag == -1  // *_TOO_MUCH_WORK
                  ? "; with fixed_step every step is taken: a longer fixed_step or a larger "
@@ -164,7 +164,8 @@ class SundialsIntegrator : public Integrator {
   void* mem_ = nullptr;
   OdeContext* context_ = nullptr;
   SundialsMessages messages_;
-  long max_steps_ = 0;
+  long max_steps_ = 0;      // of this integrator (max_steps less the earlier phases' steps)
+  long run_max_steps_ = 0;  // max_steps of the whole run
   std::string package_;
   bool fixed_step_ = false;
 
@@ -218,7 +219,8 @@ class Cvode : public SundialsIntegrator {
             std::string* error) {
     context_ = &c;
     package_ = "CVODE";
-    max_steps_ = std::max(1L, o.max_steps);
+    max_steps_ = std::max(1L, o.max_steps - o.steps_before);
+    run_max_steps_ = o.max_steps;
     mem_ = CVodeCreate(o.method == IntegratorMethod::kAdams ? CV_ADAMS : CV_BDF, ctx);
     if (!mem_) return fail(error, "could not create CVODE");
     CVodeSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);
@@ -280,7 +282,8 @@ class ArkodeImplicit : public SundialsIntegrator {
             std::string* error) {
     context_ = &c;
     package_ = "ARKODE";
-    max_steps_ = std::max(1L, o.max_steps);
+    max_steps_ = std::max(1L, o.max_steps - o.steps_before);
+    run_max_steps_ = o.max_steps;
     mem_ = ARKStepCreate(nullptr, ode_rhs, 0.0, y0, ctx);
     if (!mem_) return fail(error, "could not create ARKODE");
     ARKStepSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);
@@ -343,7 +346,8 @@ class ArkodeExplicit : public SundialsIntegrator {
             std::string* error) {
     context_ = &c;
     package_ = "ARKODE";
-    max_steps_ = std::max(1L, o.max_steps);
+    max_steps_ = std::max(1L, o.max_steps - o.steps_before);
+    run_max_steps_ = o.max_steps;
     mem_ = ERKStepCreate(ode_rhs, 0.0, y0, ctx);
     if (!mem_) return fail(error, "could not create ARKODE");
     ERKStepSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);

@@ -55,6 +55,7 @@ struct IntegratorOptions {
   // method resolve modes an L-stable fixed step damps). 0: adaptive steps.
   double fixed_step = 0.0;
   long max_steps = 10000000;  // step budget of the whole run (all output steps)
+  long steps_before = 0;      // steps of the run's earlier phases (auto), counted in max_steps
   // modal: the configuration linearized about: "static" (the equilibrium under the loads at
   // t = 0), "initial" (the initial state), "" (static when that equilibrium is found within
   // kModalIntegratorMaxRotation of the initial state, else initial, with a warning).

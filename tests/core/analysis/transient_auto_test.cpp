@@ -458,6 +458,17 @@ TEST(TransientAuto, AMechanismWhoseModalStepsResolveItsFastestModeGoesOnWithErk)
     EXPECT_LT(e, rtol);
     EXPECT_GT(e, 1e-3 * rtol);
   }
+  // A budget the run outgrows after the hand-over: the message gives the run's max_steps (it gave
+  // what was left of it when Verner began).
+  TransientOptions o = options(t_end, 0.01, 1e-6, 1e-8);
+  o.integrator.method = IntegratorMethod::kAuto;
+  o.integrator.about = "initial";
+  o.integrator.max_steps = 5000;
+  const TransientRun short_of_steps = simulate(top, o);
+  EXPECT_FALSE(short_of_steps.result.ok);
+  EXPECT_NE(short_of_steps.result.message.find("max_steps = 5000 over the whole run"),
+            std::string::npos)
+      << short_of_steps.result.message;
 }
 
 // A damped grounded mechanism (a body not held by beams, no floating part) runs bdf. Along a

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "core/analysis/transient.hpp"
@@ -93,6 +94,25 @@ inline TransientOptions options(double t_end, double output_step, double rtol, d
   o.integrator.rtol = rtol;
   o.integrator.atol = atol;
   return o;
+}
+
+// A tight reference run: explicit Verner 8(7) at rtol (atol 1e-2 rtol).
+inline TransientRun tight(const Model& model, double t_end, double output_step,
+                          double rtol = 1e-11) {
+  TransientOptions o = options(t_end, output_step, rtol, 1e-2 * rtol);
+  o.integrator.method = IntegratorMethod::kErk;
+  o.integrator.table = "VERNER_8_5_6";
+  return simulate(model, o);
+}
+
+// A run of `method` ("auto", "modal", "bdf" ...) at rtol (atol 1e-2 rtol), with the modal
+// method's band `band` [Hz] (0: none).
+inline TransientRun run_with(const Model& model, const std::string& method, double t_end,
+                             double output_step, double rtol, double band = 0.0) {
+  TransientOptions o = options(t_end, output_step, rtol, 1e-2 * rtol);
+  o.integrator.method = *method_from_name(method);
+  o.integrator.max_frequency_hz = band;
+  return simulate(model, o);
 }
 
 }  // namespace beamrail::testing

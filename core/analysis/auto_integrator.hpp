@@ -14,11 +14,10 @@
 //   it saves), the rest of the run is integrated by dirk (ESDIRK547L2SA2_7_4_5, L-stable: it damps
 //   the fast modes it does not resolve). A mechanism, or a part followed in a turning frame,
 //   whose modal steps already resolve its fastest mode goes on with erk instead
-//   (kAutoExplicitResolved). In a part of the scene that
-//   floats and spins the rotation counts from a reference turning with that part
-//   (core/analysis/modal_coordinates.hpp). A damped grounded mechanism (damping, a body not held by
-//   beams, no floating part) runs bdf from the start (no energy check backs relinearized modal
-//   phases there; auto_integrator.cpp).
+//   (kAutoExplicitResolved). In a part of the scene that floats and spins the rotation counts
+//   from a reference turning with that part (core/analysis/modal_coordinates.hpp). A damped
+//   grounded mechanism (damping, a body not held by beams, no floating part) runs bdf from the
+//   start (no energy check backs relinearized modal phases there; auto_integrator.cpp).
 //
 // - A band it chose itself (for rtol) is widened when the inertia of the modes it keeps
 //   quasi-static (their motion at second order: core/analysis/modal_integrator.hpp,

@@ -111,6 +111,11 @@ class ModalExponential : public Integrator {
       *error = "the modal integrator: the damping forces at the linearization are not finite";
       return false;
     }
+    order_.resize(blocks_.lambda.size());
+    for (Eigen::Index i = 0; i < blocks_.lambda.size(); ++i) order_[i] = i;
+    std::sort(order_.begin(), order_.end(), [&](Eigen::Index a, Eigen::Index b) {
+      return blocks_.lambda[a] > blocks_.lambda[b];
+    });
     bounds_ = ModalStepBounds(
         o.rtol,
         blocks_.lambda.size() > 0 ? std::sqrt(std::max(blocks_.lambda.maxCoeff(), 0.0)) : 0.0,
@@ -196,6 +201,12 @@ class ModalExponential : public Integrator {
            (bounds_.hold_mechanism || modal_stiff_share(blocks_.lambda, z_) > kMechanismStiffShare);
   }
   void hold_mechanism_bound() { bounds_.hold_mechanism = true; }
+
+  // The frequency of the mechanism's ringing modes at the accepted state [rad/s] (0: none).
+  double ringing_rate() const {
+    if (!(bounds_.mechanism_wh > 0.0)) return 0.0;
+    return modal_ringing_rate(blocks_.lambda, order_, z_, kMechanismRingingShare);
+  }
 
   std::string failure(int flag) const override {
     if (context_->timed_out) return "timeout: the run exceeded its max_seconds budget";
@@ -633,7 +644,7 @@ class ModalExponential : public Integrator {
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
-        h = bounds_.limit(h, h_, mechanism_bound());
+        h = bounds_.limit(h, h_, mechanism_bound(), ringing_rate());
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
@@ -773,6 +784,7 @@ class ModalExponential : public Integrator {
   int far_body_ = -1;
   std::string detail_;
   double max_rotation_ = kModalIntegratorMaxRotation;
+  std::vector<Eigen::Index> order_;  // the modes from the fastest down
   ModalStepBounds bounds_;         // the longest steps beside the estimates (modal_step_bounds.hpp)
   double low_order_weight_ = 1.0;  // rtol^(1/4) / kLowOrderScale
 };

@@ -40,19 +40,41 @@ double modal_stiff_share(const Eigen::ArrayXd& lambda, const ModeBlock& z) {
   return total > 0.0 ? stiff / total : 0.0;
 }
 
+double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
+                          const ModeBlock& z, double share) {
+  double total = 0.0;
+  for (Eigen::Index i = 0; i < lambda.size(); ++i)
+    total += z(i, 1) * z(i, 1) + std::max(lambda[i], 0.0) * z(i, 0) * z(i, 0);
+  if (!(total > 0.0)) return 0.0;
+  double above = 0.0;
+  for (Eigen::Index i : order) {
+    const double l = std::max(lambda[i], 0.0);
+    above += z(i, 1) * z(i, 1) + l * z(i, 0) * z(i, 0);
+    if (above > share * total) return std::sqrt(l);
+  }
+  return 0.0;
+}
+
 ModalStepBounds::ModalStepBounds(double rtol, double w_max, bool turning_frame,
                                  bool mechanism_moves, double harmonic_hz) {
   if (w_max > 0.0) {
     if (turning_frame) turning = turning_step_bound(rtol) / w_max;
-    if (mechanism_moves) mechanism = mechanism_step_bound(rtol) / w_max;
+    if (mechanism_moves) {
+      mechanism_wh = mechanism_step_bound(rtol);
+      mechanism = mechanism_wh / w_max;
+    }
   }
   if (harmonic_hz > 0.0)
     harmonic = kHarmonicStep * std::pow(rtol, 0.25) / (2.0 * std::numbers::pi * harmonic_hz);
 }
 
-double ModalStepBounds::limit(double h, double estimates, bool mechanism_holds) const {
+double ModalStepBounds::limit(double h, double estimates, bool mechanism_holds,
+                              double ringing_rate) const {
   if (turning > 0.0) h = std::min(h, turning);
-  if (mechanism_holds) h = std::min(h, std::max(mechanism, estimates / kMechanismMostShorter));
+  if (mechanism_holds)
+    h = std::min(h, std::max(mechanism, estimates / kMechanismMostShorter));
+  else if (mechanism_wh > 0.0 && ringing_rate > 0.0)
+    h = std::min(h, std::max(mechanism_wh / ringing_rate, estimates / kMechanismMostShorter));
   if (harmonic > 0.0) h = std::min(h, harmonic);
   return h;
 }

@@ -3,6 +3,8 @@
 // Each constant is fitted to the runs its comment names.
 #pragma once
 
+#include <vector>
+
 #include "core/analysis/exponential_step.hpp"
 #include "core/model/model.hpp"
 
@@ -62,6 +64,26 @@ inline constexpr double kMechanismStiffShare = 1e-8;
 // were far too long (421 / 316 / 1,800 rtol off before the bound), and it came out 41 / 890 /
 // 33 rtol off at 10 times, 22 / 11 / 14 at 30, 0.004 / 0.07 / 4.0 at 100.
 inline constexpr double kMechanismMostShorter = 100.0;
+// A mechanism's slower modes ring too, and the remainder carries their ringing into the motion
+// (a joint's tension rings in its axial mode and pulls on the swing with it): the estimates
+// sample that forcing at the stages of a step and do not see a step that skips its periods.
+// A 1 kg bob hanging at rest 0.3 m below a revolute joint of the default compliance, released
+// with the joint unstressed (so its 910 Hz axial mode rings with gravity's sag, and holds
+// nearly all the modal energy; the stiff modes above 0.3 w_max hold 1e-10 of it), under a
+// 1e-4 N m torque at 1 Hz, 0.5 s (an adversarial review, 2026-11-29; against Verner at rtol
+// 1e-11): its swing of 15 um came out 0.22 / 53 / 370 times its error weights off at rtol
+// 1e-4 / 1e-6 / 1e-8 (53 / 86 / 4,095 steps), silent. With steps at w h = 6.1, 3.8, 2.0, 1.2,
+// 0.6 in the ringing mode it was 12, 2.3, 0.13, 0.019, 6e-4 times its weights off at rtol 1e-6
+// (about (w h)^4). So the steps also stay below the mechanism's bound on w h (3 / 1.9 / 0.6 at
+// rtol 1e-4 / 1e-6 / 1e-8, at most kMechanismMostShorter times shorter than the estimates'
+// step) in the slowest of the fastest modes that together hold more than
+// kMechanismRingingShare of the modal energy (modal_ringing_rate): 0.003 / 1e-4 / 0.086 times
+// its weights off (981 / 1,226 / 6,991 steps). A share of 1e-5, 1e-3 or 1e-2 bounded more steps
+// of the review's other mechanisms, but with their steps then at the shortest the bound allows
+// (kMechanismMostShorter times the estimates' step) it moved some of them by chance either way
+// (a bob on a joint of compliance 1e-9, 0.18 rtol off at rtol 1e-4: 0.15 at 1e-3 with 3.3 times
+// the steps, 4.1 at 1e-2).
+inline constexpr double kMechanismRingingShare = 0.1;
 // With a harmonic load of frequency f (the highest), the steps stay below kHarmonicStep
 // rtol^(1/4) / (2 pi f): the third-order estimate compares two evaluations at the same time
 // (c = 1/2) and cannot see a load's change within the step, and the second-order one saw too
@@ -89,10 +111,16 @@ bool moves_as_mechanism(const Model& model);
 // and velocities (column 1) from the linearization's reference.
 double modal_stiff_share(const Eigen::ArrayXd& lambda, const ModeBlock& z);
 
+// The frequency [rad/s] of the slowest of the fastest modes that together hold more than `share`
+// of that modal energy: `order` the modes from the fastest down; 0 when no mode holds energy.
+double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
+                          const ModeBlock& z, double share);
+
 // The bounds of one linearization [s]; 0: none.
 struct ModalStepBounds {
   double turning = 0.0;         // in a turning frame (kTurningFrameStep)
   double mechanism = 0.0;       // a mechanism's, while its stiff modes hold energy (kMechanismStep)
+  double mechanism_wh = 0.0;    // a mechanism's bound on w h (kMechanismRingingShare)
   double harmonic = 0.0;        // with harmonic loads (kHarmonicStep)
   bool hold_mechanism = false;  // the mechanism's bound from the start, whatever the share
 
@@ -104,8 +132,9 @@ struct ModalStepBounds {
 
   // The step `h` within the bounds; `estimates` the step the error estimates ask for;
   // `mechanism_holds`: the mechanism's bound holds (hold_mechanism, or its stiff modes hold more
-  // than kMechanismStiffShare of the energy).
-  double limit(double h, double estimates, bool mechanism_holds) const;
+  // than kMechanismStiffShare of the energy); else, for a mechanism, `ringing_rate` the frequency
+  // of its ringing modes [rad/s] (modal_ringing_rate, kMechanismRingingShare; 0: none).
+  double limit(double h, double estimates, bool mechanism_holds, double ringing_rate) const;
 };
 
 }  // namespace beamrail

@@ -644,7 +644,8 @@ class ModalExponential : public Integrator {
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
-        h = bounds_.limit(h, h_, mechanism_bound(), ringing_rate());
+        const bool mechanism_holds = mechanism_bound();
+        h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate());
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;

@@ -68,22 +68,27 @@ inline constexpr double kMechanismMostShorter = 100.0;
 // (a joint's tension rings in its axial mode and pulls on the swing with it): the estimates
 // sample that forcing at the stages of a step and do not see a step that skips its periods.
 // A 1 kg bob hanging at rest 0.3 m below a revolute joint of the default compliance, released
-// with the joint unstressed (so its 910 Hz axial mode rings with gravity's sag, and holds
-// nearly all the modal energy; the stiff modes above 0.3 w_max hold 1e-10 of it), under a
-// 1e-4 N m torque at 1 Hz, 0.5 s (an adversarial review, 2026-11-29; against Verner at rtol
-// 1e-11): its swing of 15 um came out 0.22 / 53 / 370 times its error weights off at rtol
-// 1e-4 / 1e-6 / 1e-8 (53 / 86 / 4,095 steps), silent. With steps at w h = 6.1, 3.8, 2.0, 1.2,
-// 0.6 in the ringing mode it was 12, 2.3, 0.13, 0.019, 6e-4 times its weights off at rtol 1e-6
-// (about (w h)^4). So the steps also stay below the mechanism's bound on w h (3 / 1.9 / 0.6 at
-// rtol 1e-4 / 1e-6 / 1e-8, at most kMechanismMostShorter times shorter than the estimates'
-// step) in the slowest of the fastest modes that together hold more than
-// kMechanismRingingShare of the modal energy (modal_ringing_rate): 0.003 / 1e-4 / 0.086 times
-// its weights off (981 / 1,226 / 6,991 steps). A share of 1e-5, 1e-3 or 1e-2 bounded more steps
-// of the review's other mechanisms, but with their steps then at the shortest the bound allows
-// (kMechanismMostShorter times the estimates' step) it moved some of them by chance either way
-// (a bob on a joint of compliance 1e-9, 0.18 rtol off at rtol 1e-4: 0.15 at 1e-3 with 3.3 times
-// the steps, 4.1 at 1e-2).
-inline constexpr double kMechanismRingingShare = 0.1;
+// with the joint unstressed (so its 910 Hz axial mode rings with gravity's sag; the stiff modes
+// above 0.3 w_max hold 1e-10 of the energy), under a 1e-4 N m torque at 1 Hz, 0.5 s (an
+// adversarial review, 2026-11-29; against Verner at rtol 1e-11, in rtol of its 15 um swing):
+// 144 / 3.5e4 / 2.5e5 off at rtol 1e-4 / 1e-6 / 1e-8 (53 / 86 / 4,095 steps), silent. With
+// steps at w h = 6.1, 3.8, 2.0, 1.2, 0.6 in the ringing mode it was 12, 2.3, 0.13, 0.019, 6e-4
+// times its error weights off at rtol 1e-6 (about (w h)^4). So the steps also stay below the
+// mechanism's bound on w h (3 / 1.9 / 0.6 at rtol 1e-4 / 1e-6 / 1e-8, at most
+// kMechanismMostShorter times shorter than the estimates' step) in the slowest of the fastest
+// modes that together hold more than kMechanismRingingShare of the modal energy
+// (modal_ringing_rate; the stiff modes above hold less than kMechanismStiffShare, or their own
+// bound holds): 2.1 / 0.068 / 57 (981 / 1,226 / 6,991 steps). The same bob on a joint of
+// compliance 1e-9 (a stiffer ringing of the same tension, holding less energy as the swing
+// grows): 24 / 2.4e3 / 4.6e5 before, 3.9e-5 / 0.0039 / 0.39 held (10,000 steps each); with a
+// share of 0.1 the ringing dropped out of it and the bound made it worse, 565 / 7.5e4 / 6.3e6.
+// Weighted by the modes' accelerations (lambda times their energy) the stiff modes of the bob
+// hinged below a cantilever (studies/hinged_bob.json) held half of it: 30 times the steps.
+// What 1e-5 costs on the reviews' mechanisms: at most 3.3 times the steps at rtol 1e-4 on a bob
+// on a joint of compliance 1e-9 (0.18 / 0.15 rtol off), 3.2 times at 1e-6 on the hinged bob
+// (both already right); many runs took fewer (README "A mechanism's ringing modes hold its
+// steps").
+inline constexpr double kMechanismRingingShare = 1e-5;
 // With a harmonic load of frequency f (the highest), the steps stay below kHarmonicStep
 // rtol^(1/4) / (2 pi f): the third-order estimate compares two evaluations at the same time
 // (c = 1/2) and cannot see a load's change within the step, and the second-order one saw too

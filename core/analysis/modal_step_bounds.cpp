@@ -27,15 +27,23 @@ bool moves_as_mechanism(const Model& model) {
   return false;
 }
 
+namespace {
+
+// Twice mode i's energy: zdot_i^2 + lambda_i z_i^2 (lambda below 0 taken as 0).
+double mode_energy(const Eigen::ArrayXd& lambda, const ModeBlock& z, Eigen::Index i) {
+  return z(i, 1) * z(i, 1) + std::max(lambda[i], 0.0) * z(i, 0) * z(i, 0);
+}
+
+}  // namespace
+
 double modal_stiff_share(const Eigen::ArrayXd& lambda, const ModeBlock& z) {
   if (lambda.size() == 0) return 0.0;
   const double lambda_stiff = kMechanismStiffModes * kMechanismStiffModes * lambda.maxCoeff();
   double total = 0.0, stiff = 0.0;
   for (Eigen::Index i = 0; i < lambda.size(); ++i) {
-    const double l = std::max(lambda[i], 0.0);
-    const double e = z(i, 1) * z(i, 1) + l * z(i, 0) * z(i, 0);
+    const double e = mode_energy(lambda, z, i);
     total += e;
-    if (l > lambda_stiff) stiff += e;
+    if (std::max(lambda[i], 0.0) > lambda_stiff) stiff += e;
   }
   return total > 0.0 ? stiff / total : 0.0;
 }
@@ -43,14 +51,12 @@ double modal_stiff_share(const Eigen::ArrayXd& lambda, const ModeBlock& z) {
 double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
                           const ModeBlock& z, double share) {
   double total = 0.0;
-  for (Eigen::Index i = 0; i < lambda.size(); ++i)
-    total += z(i, 1) * z(i, 1) + std::max(lambda[i], 0.0) * z(i, 0) * z(i, 0);
+  for (Eigen::Index i = 0; i < lambda.size(); ++i) total += mode_energy(lambda, z, i);
   if (!(total > 0.0)) return 0.0;
   double above = 0.0;
   for (Eigen::Index i : order) {
-    const double l = std::max(lambda[i], 0.0);
-    above += z(i, 1) * z(i, 1) + l * z(i, 0) * z(i, 0);
-    if (above > share * total) return std::sqrt(l);
+    above += mode_energy(lambda, z, i);
+    if (above > share * total) return std::sqrt(std::max(lambda[i], 0.0));
   }
   return 0.0;
 }

@@ -159,6 +159,7 @@ class ModalExponential : public Integrator {
   void restart(double t, N_Vector y) override {
     t_ = t;
     have_n0_ = false;
+    starting_ = true;
     quasi_.restart();
     from_states(N_VGetArrayPointer(y));
   }
@@ -195,17 +196,31 @@ class ModalExponential : public Integrator {
   // The largest rotation of a body from the linearization at the accepted state [rad].
   double largest_rotation() const { return coordinates_.largest_rotation(x_); }
 
-  // Whether the mechanism's step bound holds at the accepted state.
-  bool mechanism_bound() const {
+  // Whether the mechanism's step bound holds at the accepted state (z: the modes there, z_ or
+  // with their ringing about the static state of the forces: ringing_about_static_state).
+  bool mechanism_bound(const ModeBlock& z) const {
     return bounds_.mechanism > 0.0 &&
-           (bounds_.hold_mechanism || modal_stiff_share(blocks_.lambda, z_) > kMechanismStiffShare);
+           (bounds_.hold_mechanism || modal_stiff_share(blocks_.lambda, z) > kMechanismStiffShare);
   }
+  bool mechanism_bound() const { return mechanism_bound(z_); }
   void hold_mechanism_bound() { bounds_.hold_mechanism = true; }
 
+  // The modes at the accepted state with their ringing about the static state of the forces
+  // there (ringing_about_static_state), once the step's start has been evaluated: the
+  // band-limited iteration left Phi^T M0 a in psi_a_; else M0 a is in m0_v_ (one more pass).
+  const ModeBlock& start_ringing() {
+    if (!reduced_) {
+      psi_a_.resize(m_);
+      multiply_transposed(phi_, m0_v_.data(), psi_a_.data());
+    }
+    start_ringing_ = ringing_about_static_state(blocks_.lambda, z_, psi_a_);
+    return start_ringing_;
+  }
+
   // The frequency of the mechanism's ringing modes at the accepted state [rad/s] (0: none).
-  double ringing_rate() const {
+  double ringing_rate(const ModeBlock& z) const {
     if (!(bounds_.mechanism_wh > 0.0)) return 0.0;
-    return modal_ringing_rate(blocks_.lambda, order_, z_, kMechanismRingingShare);
+    return modal_ringing_rate(blocks_.lambda, order_, z, kMechanismRingingShare);
   }
 
   std::string failure(int flag) const override {
@@ -641,11 +656,17 @@ class ModalExponential : public Integrator {
       }
       if (reduced_) quasi_.begin_step();  // the quasi-static part at the accepted state
       if (h_ <= 0.0) h_ = options_.initial_step > 0.0 ? options_.initial_step : (target - t_);
+      // A mechanism's first step from rest (at the start, or restarted at a load's jump): the
+      // modes as they will ring about the static state of the forces there. Only from rest: in
+      // motion the accelerations hold the motion's own (a swing's centripetal one along its
+      // stiff joint), which no ringing follows, and a relinearized phase would pay for it.
+      const ModeBlock& ringing =
+          starting_ && bounds_.mechanism_wh > 0.0 && z_.col(1).isZero(0.0) ? start_ringing() : z_;
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
-        const bool mechanism_holds = mechanism_bound();
-        h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate());
+        const bool mechanism_holds = mechanism_bound(ringing);
+        h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate(ringing));
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
@@ -683,6 +704,7 @@ class ModalExponential : public Integrator {
             quasi_.accepted(h, StepFunctions::c[StepFunctions::kStages - 1], z_.col(1));
           }
           have_n0_ = false;
+          starting_ = false;
           ++stats_.steps;
           const double grow = err > 0.0 ? 0.9 * std::pow(err, -kExponent) : 4.0;
           if (h >= 0.999 * h_ || grow < 1.0) h_ = h * std::clamp(grow, 0.2, attempt ? 1.0 : 4.0);
@@ -758,6 +780,8 @@ class ModalExponential : public Integrator {
   Eigen::VectorXd m0_a_, psi_a_;  // work space: M0 a, Phi^T M0 a
   Block n0_;                      // N at the accepted state, when have_n0_
   bool have_n0_ = false;
+  bool starting_ = true;          // no step accepted since the start or the last restart
+  ModeBlock start_ringing_;       // start_ringing()
   double band_hz_ = 0.0;          // the highest frequency integrated [Hz]
   double band_estimate_ = -1.0;   // a chosen band's estimated error (modal_band.hpp); -1: given
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed

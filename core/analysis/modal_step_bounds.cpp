@@ -61,6 +61,15 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
   return 0.0;
 }
 
+ModeBlock ringing_about_static_state(const Eigen::ArrayXd& lambda, const ModeBlock& z,
+                                     const Eigen::VectorXd& psi_a) {
+  ModeBlock out = z;
+  for (Eigen::Index i = 0; i < lambda.size(); ++i)
+    if (lambda[i] > 0.0 && std::abs(psi_a[i]) / lambda[i] > std::abs(z(i, 0)))
+      out(i, 0) = psi_a[i] / lambda[i];
+  return out;
+}
+
 ModalStepBounds::ModalStepBounds(double rtol, double w_max, bool turning_frame,
                                  bool mechanism_moves, double harmonic_hz) {
   if (w_max > 0.0) {

@@ -327,5 +327,38 @@ TEST(JointElements, AJointFarFromTheOriginHoldsExactlyNothingAtRest) {
   EXPECT_LT(worst_pull, 1e-14);
 }
 
+// A joint's rotational energy for a tiny turn across its axis is k_moment (1 - cos theta) =
+// 2 k_moment sin^2(theta / 2) to rounding: summed as 1 - a1.a2, a1.a2 rounded to steps of 1.1e-16
+// near 1, which a joint of relative compliance 1e-9 made steps of 6.5e-7 J (the energy check then
+// reported a bob swinging 1 degree on it as 0.0015 of its energy off, even for an explicit run at
+// rtol 1e-12). A body on a revolute or fixed joint at its centre (no lever: no gap), turned by
+// 1e-9 .. 1e-5 rad about an axis across the joint's: summed as 1 - a1.a2 it was off by 1.0 (0
+// below 1e-8 rad); now by 3e-16.
+TEST(JointElements, AStiffJointsEnergyOfATinyTurnIsItsClosedForm) {
+  for (const std::string type : {"revolute", "fixed"}) {
+    Scene s;
+    s.material("steel", kE, kG, kDensity).square("sq", kSide);
+    s.body("b", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.2, -0.3, 0.1));
+    Json j = joint("pin", type, "ground", "b", Vec3(0.2, -0.3, 0.1));
+    if (type == "revolute") j["axis"] = vec(0, 0, 1);
+    j["relative_compliance"] = 1e-9;
+    s.j["joints"] = Json::array({j});
+    const Model model = s.model();
+    Data data(model);
+    const int b = body_index(model, "b");
+    double worst = 0.0;
+    for (const double theta : {1e-9, 1e-8, 1e-7, 1e-6, 1e-5}) {
+      data.pose[b].A = Eigen::AngleAxisd(theta, Vec3(0.6, 0.8, 0.0)).toRotationMatrix();
+      compute_wrenches(model, data, 0.0);
+      const double sine = std::sin(0.5 * theta);
+      const double expected = 2.0 * model.joints[0].k_moment * sine * sine;
+      worst = std::max(worst, std::abs(data.elastic_energy - expected) / expected);
+    }
+    std::printf("%s joint, k_moment %.2e N m: energy of turns 1e-9 .. 1e-5 rad off by %.1e\n",
+                type.c_str(), model.joints[0].k_moment, worst);
+    EXPECT_LT(worst, 1e-6);
+  }
+}
+
 }  // namespace
 }  // namespace beamrail

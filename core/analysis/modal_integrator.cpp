@@ -656,12 +656,9 @@ class ModalExponential : public Integrator {
       }
       if (reduced_) quasi_.begin_step();  // the quasi-static part at the accepted state
       if (h_ <= 0.0) h_ = options_.initial_step > 0.0 ? options_.initial_step : (target - t_);
-      // A mechanism's first step from rest (at the start, or restarted at a load's jump): the
-      // modes as they will ring about the static state of the forces there. Only from rest: in
-      // motion the accelerations hold the motion's own (a swing's centripetal one along its
-      // stiff joint), which no ringing follows, and a relinearized phase would pay for it.
-      const ModeBlock& ringing =
-          starting_ && bounds_.mechanism_wh > 0.0 && z_.col(1).isZero(0.0) ? start_ringing() : z_;
+      // A mechanism's first step (from the run's start, a load's jump or auto's relinearization):
+      // the modes as they will ring about the static state of the forces there.
+      const ModeBlock& ringing = starting_ && bounds_.mechanism_wh > 0.0 ? start_ringing() : z_;
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);

@@ -122,7 +122,7 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
                           const ModeBlock& z, double share);
 
 // z for the bounds of a step from a state where the forces may set modes ringing that do not
-// ring yet (a mechanism's first step from rest, at the start or at a load's jump): each mode's
+// ring yet (a mechanism's first step, at the start or at a load's jump): each mode's
 // displacement from the static state of the forces at the step's start, |psi_a_i| / lambda_i
 // (psi_a = Phi^T M0 a, the modal accelerations), where that is larger than |z_i| (modes of
 // lambda_i <= 0 as they are). A mode's energy is then the larger of its own and of its ringing
@@ -132,9 +132,10 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // under gravity and pushed along the rail by 1 mN at 1 Hz (an adversarial review, 2026-11-29),
 // kept that step's velocity error along the rail, and after 1 s it was 0.11 / 12 / 5.4 rtol of
 // its motion off at rtol 1e-4 / 1e-6 / 1e-8 (against Verner at rtol 1e-11), silent; with its
-// first step held so, 0.026 / 0.077 / 0.010. Only from rest: in motion the accelerations hold
-// the motion's own (a swing's centripetal one along its stiff joint), which no ringing follows.
-// What it does on the reviews' other mechanisms: README "A mechanism's first step from rest".
+// first step held so, 0.026 / 0.077 / 0.010. At every start (the run's, a load's jump, auto's
+// relinearization), at rest or not: a first form asked for exact rest, and a carriage nudged at
+// 1e-12 m/s along its rail kept the error. What it does on the reviews' other mechanisms: README
+// "A mechanism's first step from rest".
 ModeBlock ringing_about_static_state(const Eigen::ArrayXd& lambda, const ModeBlock& z,
                                      const Eigen::VectorXd& psi_a);
 

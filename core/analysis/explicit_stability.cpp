@@ -80,6 +80,13 @@ double largest_damping(const Model& model) {
   return beta;
 }
 
+double fastest_mode(const Model& model, Data& data, const double* y0, double t0) {
+  set_state(model, data, y0);
+  compute_wrenches(model, data, t0);
+  compute_tangent(model, data, t0, false);
+  return std::sqrt(largest_eigenvalue(model, data));
+}
+
 FixedStepStability fixed_step_stability(const Model& model, Data& data, const double* y0, double t0,
                                         const std::string& arkode_table, double h,
                                         double duration) {
@@ -93,13 +100,9 @@ FixedStepStability fixed_step_stability(const Model& model, Data& data, const do
     for (int j = 0; j < r.stages; ++j) r.a.push_back(table->A[i][j]);
   }
   ARKodeButcherTable_Free(table);
-  set_state(model, data, y0);
-  compute_wrenches(model, data, t0);
-  compute_tangent(model, data, t0, false);
-  const double largest = largest_eigenvalue(model, data);
-  if (!(largest > 0.0)) return out;
+  out.fastest = fastest_mode(model, data, y0, t0);
+  if (!(out.fastest > 0.0)) return out;
   out.checked = true;
-  out.fastest = std::sqrt(largest);
   const double beta = largest_damping(model);
   out.growth = growth(r, out.fastest, beta, h, duration);
   // The longest stable step, from h down by 2 % at a time (the growth need not be monotone in

@@ -357,7 +357,16 @@ class ArkodeExplicit : public SundialsIntegrator {
     if (ERKStepSStolerances(mem_, o.rtol, o.atol) < 0 || ERKStepSetUserData(mem_, &c) < 0)
       return fail(error, "ARKODE set-up failed: " + messages_.last);
     ERKStepSetPostprocessStepFn(mem_, ode_normalize);
-    if (o.max_step > 0.0) ERKStepSetMaxStep(mem_, o.max_step);
+    double max_step = o.max_step;
+    if (o.fixed_step <= 0.0) {
+      // Not so far beyond the table's stability that its rows go wrong (explicit_longest_wh).
+      const double fastest = fastest_mode(c.model, c.data, N_VGetArrayPointer(y0), 0.0);
+      if (fastest > 0.0) {
+        const double longest = explicit_longest_wh(o.rtol) / fastest;
+        if (!(max_step > 0.0) || longest < max_step) max_step = longest;
+      }
+    }
+    if (max_step > 0.0) ERKStepSetMaxStep(mem_, max_step);
     if (o.initial_step > 0.0) ERKStepSetInitStep(mem_, o.initial_step);
     if (o.fixed_step > 0.0) {
       if (ERKStepSetFixedStep(mem_, o.fixed_step) < 0)

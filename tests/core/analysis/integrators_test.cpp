@@ -20,6 +20,7 @@ using testing::motion_error;
 using testing::options;
 using testing::scene_from_json;
 using testing::simulate;
+using testing::Snapshot;
 using testing::TransientRun;
 
 using testing::reference_cantilever;
@@ -164,6 +165,55 @@ TEST(Integrators, AnUnstableExplicitFixedStepIsRefused) {
   const double e = motion_error(run, reference, tip);
   std::printf("at the step named, %.3g s: error %.2e against a tight run\n", stable, e);
   EXPECT_LT(e, 1e-6);
+}
+
+// An explicit run of a scene exactly at rest until a load's jump: nothing limits its steps
+// there, and ARKODE's rows between them (Hermite interpolants of degree 5, which evaluate the
+// forces at interpolated states) turned the interpolation's rounding into motion through the
+// stiff forces: a flexible pendulum on the default joint wrote 7e-7 m and 5.18 J at rest. The
+// steps now stay within explicit_longest_wh of the fastest mode (explicit_stability.hpp): the rows
+// before the jump are the rest state, and the motion after it is a tight bdf run's. Here the
+// joint is softer to keep the test short: without the bound Verner's rows moved the bodies by
+// 7.2e-10 m with 5.4e-8 J, and Dormand-Prince's held 2.9e-15 J.
+TEST(Integrators, AnExplicitRunsRowsAtRestStayAtRest) {
+  const Model model = scene_from_json(R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"rod": {"shape": "circle", "diameter": 0.005}},
+    "bodies": [{"name": "arm", "mass": 1, "inertia": [0.01, 0.01, 0.01], "position": [0.2, 0, 0]},
+               {"name": "tip", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5],
+                "position": [0.6, 0, 0]}],
+    "joints": [{"name": "hinge", "type": "revolute", "body1": "ground", "body2": "arm",
+                "point": [0, 0, 0], "axis": [0, 0, 1], "relative_compliance": 1e-4}],
+    "beams": [{"name": "rod", "body1": "arm", "body2": "tip", "point1": [0.2, 0, 0],
+               "point2": [0.6, 0, 0], "point3": [0.2, 0, 1], "material": "steel",
+               "section": "rod", "segments": 2}],
+    "loads": [{"type": "force", "body": "tip", "value": [0, 1, 0],
+               "time": {"type": "step", "at": 0.04}}]})");
+  const int tip = body_index(model, "tip");
+  TransientOptions o = options(0.045, 5e-4, 1e-11, 1e-13);
+  const TransientRun reference = simulate(model, o);  // bdf
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  for (const char* table : {"VERNER_8_5_6", ""}) {
+    o.integrator.method = IntegratorMethod::kErk;
+    o.integrator.table = table;
+    const TransientRun run = simulate(model, o);
+    ASSERT_TRUE(run.result.ok) << run.result.message;
+    double moved = 0.0, energy = 0.0;
+    for (const Snapshot& s : run.samples) {
+      if (s.sample.t >= 0.04) break;
+      for (size_t i = 0; i < s.c.size(); ++i)
+        moved = std::max(moved, (s.c[i] - run.samples[0].c[i]).norm());
+      energy = std::max(energy, std::abs(s.sample.energy()));
+    }
+    const double e = motion_error(run, reference, tip);
+    std::printf(
+        "erk %s: %ld steps; before the jump the rows moved %.2e m with %.2e J; after, "
+        "%.2e against bdf\n",
+        *table ? table : "default", run.result.stats.steps, moved, energy, e);
+    EXPECT_LT(moved, 1e-14);
+    EXPECT_LT(energy, 1e-15);
+    EXPECT_LT(e, 1e-7);
+  }
 }
 
 // Dense LU and sparse KLU solve the same Newton systems: the runs differ only by rounding.

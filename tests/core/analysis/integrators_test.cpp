@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <string>
 
+#include "tests/support/point_mass_tip.hpp"
 #include "tests/support/reference_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 
@@ -224,14 +225,7 @@ TEST(Integrators, AnExplicitRunsRowsAtRestStayAtRest) {
 // derivatives evaluated, 0.0026 / 0.014 / 0.025 / 0.083 (ESDIRK547 1.1 / 0.70 / 0.85 / 0.18 ->
 // below 0.012).
 TEST(Integrators, ImplicitRungeKuttaFollowsRtolWhereAStiffModeRings) {
-  const Model model = scene_from_json(R"({
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
-    "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "tip", "mass": 3.0, "inertia": [1e-6, 1e-6, 1e-6], "position": [1, 0, 0]}],
-    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq"}],
-    "loads": [{"type": "force", "body": "tip", "value": [0, -1, 0],
-               "time": {"type": "step", "at": 0.0}}]})");
+  const Model model = scene_from_json(testing::point_mass_tip(0.01, 1.0));
   const int tip = body_index(model, "tip");
   const TransientRun reference = testing::tight(model, 0.3, 1e-3);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;

@@ -10,6 +10,7 @@
 #include "core/analysis/modal_integrator.hpp"
 #include "core/scene/scene_loader.hpp"
 #include "tests/support/heavy_tip_cantilever.hpp"
+#include "tests/support/point_mass_tip.hpp"
 #include "tests/support/reference_cantilever.hpp"
 #include "tests/support/transient_run.hpp"
 #include "tests/support/tumbling_pair.hpp"
@@ -30,14 +31,7 @@ using testing::TransientRun;
 // 40 mm square steel under a 1 kN step load: bending at 34 Hz and a 4e5 rad/s rotary mode. bdf
 // took 1.6 million steps (29 s) for 0.3 s at rtol 1e-11; auto takes the modal method, which
 // integrates both modes exactly: one step per output interval.
-const char* kPointMassTip = R"({
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
-    "sections": {"sq40": {"shape": "rectangle", "width": 0.04, "height": 0.04}},
-    "bodies": [{"name": "tip", "mass": 3.0, "inertia": [1e-6, 1e-6, 1e-6], "position": [1, 0, 0]}],
-    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq40"}],
-    "loads": [{"type": "force", "body": "tip", "value": [0, -1000, 0],
-               "time": {"type": "step", "at": 0.0}}]})";
+const std::string kPointMassTip = testing::point_mass_tip(0.04, 1000.0);
 
 TEST(TransientAuto, PointMassTipTakesTheModalMethod) {
   const Model model = scene_from_json(kPointMassTip);

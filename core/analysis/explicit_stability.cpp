@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <stdexcept>
 #include <vector>
 
 #include "core/model/dynamics.hpp"
@@ -42,7 +43,7 @@ double largest_eigenvalue(const Model& model, const Data& data) {
   k = 0.5 * Eigen::SparseMatrix<double>(k + Eigen::SparseMatrix<double>(k.transpose()));
   const Eigen::SparseMatrix<double> m = mass_matrix(model, data);
   const Eigen::Index n = k.rows();
-  if (n == 0) return 0.0;
+  if (n == 0 || k.squaredNorm() == 0.0) return 0.0;  // no elements: no elastic mode
   Spectra::SparseSymMatProd<double> op(k);
   Spectra::SparseCholesky<double> bop(m);
   if (bop.info() != Spectra::CompInfo::Successful) return 0.0;
@@ -50,7 +51,11 @@ double largest_eigenvalue(const Model& model, const Data& data) {
                           Spectra::GEigsMode::Cholesky>
       eigs(op, bop, 1, std::min<Eigen::Index>(n, 24));
   eigs.init();
-  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-6);
+  try {
+    eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-6);
+  } catch (const std::exception&) {
+    return 0.0;  // Spectra throws where its tridiagonal eigenproblem fails
+  }
   if (eigs.info() != Spectra::CompInfo::Successful) return 0.0;
   return std::max(0.0, eigs.eigenvalues()(0));
 }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 
 #include "tests/support/point_mass_tip.hpp"
@@ -217,6 +218,26 @@ TEST(Integrators, AnExplicitRunsRowsAtRestStayAtRest) {
   }
 }
 
+// Runs dirk (the default table and ESDIRK547) at each rtol, atol = `base.integrator.atol` x rtol,
+// with `base`'s span and outputs, and expects body `b` within rtol of its motion in `reference`.
+void expect_dirk_within_rtol(const Model& model, const TransientRun& reference, int b,
+                             const TransientOptions& base, std::initializer_list<double> rtols,
+                             const char* label) {
+  for (const char* table : {"", "ESDIRK547L2SA2_7_4_5"}) {
+    for (double rtol : rtols) {
+      TransientOptions o = options(base.t_end, base.output_step, rtol, base.integrator.atol * rtol);
+      o.integrator.method = IntegratorMethod::kDirk;
+      o.integrator.table = table;
+      const TransientRun run = simulate(model, o);
+      ASSERT_TRUE(run.result.ok) << run.result.message;
+      const double e = motion_error(run, reference, b) / rtol;
+      std::printf("%s, dirk %s, rtol %.0e: %.3g rtol of the motion, %ld steps\n", label,
+                  *table ? table : "default", rtol, e, run.result.stats.steps);
+      EXPECT_LT(e, 1.0);
+    }
+  }
+}
+
 // The implicit Runge-Kutta methods where a stiff mode rings against a slow motion: a 3 kg
 // point-mass tip (rotary inertia 1e-6 kg m^2: a 5e5 rad/s rotary mode beside 13 rad/s bending) on
 // a 1 m cantilever of 10 mm steel under a 1 N step. With each stage's derivative deduced from its
@@ -229,19 +250,8 @@ TEST(Integrators, ImplicitRungeKuttaFollowsRtolWhereAStiffModeRings) {
   const int tip = body_index(model, "tip");
   const TransientRun reference = testing::tight(model, 0.3, 1e-3);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
-  for (const char* table : {"", "ESDIRK547L2SA2_7_4_5"}) {
-    for (double rtol : {1e-4, 1e-5, 1e-6, 1e-7}) {
-      TransientOptions o = options(0.3, 1e-3, rtol, 1e-3 * rtol);
-      o.integrator.method = IntegratorMethod::kDirk;
-      o.integrator.table = table;
-      const TransientRun run = simulate(model, o);
-      ASSERT_TRUE(run.result.ok) << run.result.message;
-      const double e = motion_error(run, reference, tip) / rtol;
-      std::printf("dirk %s, rtol %.0e: %.3g rtol of the motion, %ld steps\n",
-                  *table ? table : "default", rtol, e, run.result.stats.steps);
-      EXPECT_LT(e, 1.0);
-    }
-  }
+  expect_dirk_within_rtol(model, reference, tip, options(0.3, 1e-3, 1.0, 1e-3),
+                          {1e-4, 1e-5, 1e-6, 1e-7}, "point-mass tip");
 }
 
 // The same methods on a damped beam: the reference cantilever in 10 segments with beam damping
@@ -259,19 +269,8 @@ TEST(Integrators, ImplicitRungeKuttaFollowsRtolOnADampedBeam) {
   const int tip = body_index(model, "tip");
   const TransientRun reference = simulate(model, options(0.05, 5e-4, 1e-11, 1e-13));  // bdf
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
-  for (const char* table : {"", "ESDIRK547L2SA2_7_4_5"}) {
-    for (double rtol : {1e-4, 1e-6}) {
-      TransientOptions o = options(0.05, 5e-4, rtol, 1e-2 * rtol);
-      o.integrator.method = IntegratorMethod::kDirk;
-      o.integrator.table = table;
-      const TransientRun run = simulate(model, o);
-      ASSERT_TRUE(run.result.ok) << run.result.message;
-      const double e = motion_error(run, reference, tip) / rtol;
-      std::printf("damped beam, dirk %s, rtol %.0e: %.3g rtol of the motion, %ld steps\n",
-                  *table ? table : "default", rtol, e, run.result.stats.steps);
-      EXPECT_LT(e, 1.0);
-    }
-  }
+  expect_dirk_within_rtol(model, reference, tip, options(0.05, 5e-4, 1.0, 1e-2), {1e-4, 1e-6},
+                          "damped beam");
 }
 
 // A driven hub spins a 10 m beam (the spin-up of studies/spin_up.json, in 10 segments, up to

@@ -16,8 +16,9 @@
 //   whose modal steps already resolve its fastest mode goes on with erk instead
 //   (kAutoExplicitResolved). In a part of the scene that floats and spins the rotation counts
 //   from a reference turning with that part (core/analysis/modal_coordinates.hpp). A damped
-//   grounded mechanism (damping, a body not held by beams, no floating part) runs bdf from the
-//   start (no energy check backs relinearized modal phases there; auto_integrator.cpp).
+//   grounded mechanism (damping, a body not held by beams, no floating part) runs dirk from the
+//   start (no energy check backs relinearized modal phases there, and bdf's higher orders are
+//   unstable for its barely damped fast modes; auto_integrator.cpp).
 //
 // - A band it chose itself (for rtol) is widened when the inertia of the modes it keeps
 //   quasi-static (their motion at second order: core/analysis/modal_integrator.hpp,

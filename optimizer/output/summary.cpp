@@ -122,6 +122,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
       if (const auto& v = a.verification) {
         j["verification"] = {
             {"status", v->ok ? status_name(Status::kOk) : status_name(Status::kFailed)},
+            {"reason", v->reason},
             {"message", v->message},
             {"rtol", v->rtol},
             {"atol", v->atol},

@@ -31,6 +31,7 @@ struct Verification {
   double error = 0.0;             // largest body-centre distance between the runs / largest motion
   double rotation_error = 0.0;    // largest angle between the runs' orientations / largest turn
   SolverStats stats;              // of the tighter run
+  std::string reason;             // why the run was verified: asked, or "verify": "auto"
 };
 
 struct AnalysisReport {

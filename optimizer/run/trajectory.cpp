@@ -1,5 +1,6 @@
 #include "optimizer/run/trajectory.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -7,14 +8,18 @@
 
 namespace beamrail {
 
-Trajectory trajectory_of(const Model& model) {
+Trajectory trajectory_of(const Model& model, long rows) {
   Trajectory t;
   for (int i : model.free_bodies)
     if (!model.bodies[i].generated) t.bodies.push_back(i);
+  const long per_row = std::max(1L, static_cast<long>(t.bodies.size()));
+  if (rows > 0 && rows > kTrajectoryBodySamples / per_row)
+    t.stride = (rows * per_row + kTrajectoryBodySamples - 1) / kTrajectoryBodySamples;
   return t;
 }
 
 void Trajectory::record(const TransientSample& sample, const Data& data) {
+  if (seen++ % stride != 0) return;
   times.push_back(sample.t);
   for (int i : bodies) {
     positions.push_back(data.pose[i].u);

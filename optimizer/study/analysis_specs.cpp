@@ -96,7 +96,12 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
       IntegratorMethod::kAuto;  // the study file's default (docs/study_files.md)
   if (const Json* i = r.member("integrator", false))
     read_integrator(*i, r.at("integrator"), r.diagnostics(), a.transient.integrator);
-  a.verify = r.boolean("verify", false).value_or(false);
+  if (const Json* v = r.member("verify", false)) {
+    if (v->is_boolean())
+      a.verify = v->get<bool>() ? AnalysisSpec::Verify::kAlways : AnalysisSpec::Verify::kNever;
+    else if (!(v->is_string() && v->get<std::string>() == "auto"))
+      r.error("verify", "expected true, false or \"auto\"");
+  }
   // The band integrated: a frequency [Hz], "output": half the output rate (what the samples
   // can show), or "auto": chosen for rtol. The integrator's own max_frequency_hz, when given,
   // wins.

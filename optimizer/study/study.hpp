@@ -33,7 +33,11 @@ struct AnalysisSpec {
   ModalOptions modal;
   BucklingOptions buckling;
   bool about_static = false;  // modal: linearize about the static equilibrium (else: initial)
-  bool verify = false;  // transient: rerun at tolerances ten times tighter and report the error
+  // transient: rerun at tolerances ten times tighter and report the error. kAuto (the study
+  // file's default, "auto"): where the scene moves as a mechanism and the steps are adaptive
+  // (verification_reason in optimizer/run/evaluation.cpp says why).
+  enum class Verify { kAuto, kAlways, kNever };
+  Verify verify = Verify::kAuto;
   // transient: start at the static equilibrium of the loads at t = 0 (else: the scene's state)
   bool initial_static = false;
   Where where;

@@ -6,8 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
+#include "core/model/data.hpp"
 #include "core/model/rotation.hpp"
+#include "tests/support/scenes.hpp"
 
 namespace beamrail {
 namespace {
@@ -87,6 +90,33 @@ TEST(Trajectory, TheRotationErrorIsTheLargestAngleOverTheLargestTurn) {
   Trajectory broken = run;
   broken.orientations[7](1) = std::nan("");
   EXPECT_TRUE(std::isnan(trajectory_rotation_error(broken, reference)));
+}
+
+// A run of more body samples than kTrajectoryBodySamples keeps every stride-th row from the
+// first, the fewest rows that fit: 4 bodies over 2^19 rows (2^21 body samples) keep every second
+// row, 2^18 rows every row; a row more than the cap keeps every second.
+TEST(Trajectory, ALongRunKeepsEveryStrideThRowWithinTheCap) {
+  std::string bodies;
+  for (const char* name : {"a", "b", "c", "d"})
+    bodies += std::string(bodies.empty() ? "" : ",") + R"({"name": ")" + name +
+              R"(", "mass": 1, "inertia": [1, 1, 1], "position": [0, 0, 0]})";
+  const Model model = testing::scene_from_json(R"({"bodies": [)" + bodies + "]}");
+  ASSERT_EQ(model.n_free(), 4);
+  EXPECT_EQ(trajectory_of(model).stride, 1);
+  EXPECT_EQ(trajectory_of(model, kTrajectoryBodySamples / 4).stride, 1);
+  EXPECT_EQ(trajectory_of(model, kTrajectoryBodySamples / 4 + 1).stride, 2);
+  EXPECT_EQ(trajectory_of(model, kTrajectoryBodySamples / 2).stride, 2);
+  EXPECT_EQ(trajectory_of(model, 3 * kTrajectoryBodySamples / 4).stride, 3);
+  Trajectory t = trajectory_of(model, kTrajectoryBodySamples / 2);
+  Data data(model);
+  for (int k = 0; k < 7; ++k) {
+    TransientSample s;
+    s.t = 0.1 * k;
+    t.record(s, data);
+  }
+  ASSERT_EQ(t.times.size(), 4u);  // rows 0, 2, 4, 6
+  EXPECT_DOUBLE_EQ(t.times[3], 0.6);
+  EXPECT_EQ(t.positions.size(), 16u);
 }
 
 }  // namespace

@@ -140,6 +140,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
             {"rhs_evaluations", v->stats.rhs_evaluations},
             {"jacobian_evaluations", v->stats.jacobian_evaluations}};
         if (v->fixed_step > 0.0) j["verification"]["fixed_step"] = v->fixed_step;
+        if (v->max_step > 0.0) j["verification"]["max_step"] = v->max_step;
       }
     }
     if (a.statics) {

@@ -28,10 +28,13 @@ struct Verification {
   std::string message;
   double rtol = 0.0, atol = 0.0;  // of the tighter run
   double fixed_step = 0.0;        // of the tighter run (half the run's); 0: adaptive
-  double error = 0.0;             // largest body-centre distance between the runs / largest motion
-  double rotation_error = 0.0;    // largest angle between the runs' orientations / largest turn
-  SolverStats stats;              // of the tighter run
-  std::string reason;             // why the run was verified: asked, or "verify": "auto"
+  // Where the first rerun repeated the run state for state: the second rerun's longest step
+  // (half the run's mean step) [s]; 0: none
+  double max_step = 0.0;
+  double error = 0.0;           // largest body-centre distance between the runs / largest motion
+  double rotation_error = 0.0;  // largest angle between the runs' orientations / largest turn
+  SolverStats stats;            // of the tighter run
+  std::string reason;           // why the run was verified: asked, or "verify": "auto"
 };
 
 struct AnalysisReport {

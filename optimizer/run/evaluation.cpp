@@ -23,9 +23,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // How far past rtol an energy drift or a verification may go before the run warns: the
 // tolerance proportionality auto keeps on its tested scenes is within 10 rtol (README).
 constexpr double kDriftTolerance = 10.0;
-// The turn [rad] from which verify's rotation measure (relative to a turn of at most pi) no longer
-// tells a run's accuracy: warn_of_verification.
-constexpr double kLongestTurn = 3.0;
 
 std::string two_digits(double x) {
   char text[32];
@@ -374,16 +371,14 @@ class Runner {
       warn_of_energy_drift(spec, model, options, report.energy_max_change, energy,
                            result.stats.steps);
     if (report.ok && verify) {
-      report.verification = rerun_tighter(model, options, trajectory, result.stats.steps);
+      report.verification = rerun_tighter(model, options, trajectory, result.stats);
       report.verification->reason = verification;
       if (stop_requested() && !report.verification->ok) {
         report.ok = false;
         report.interrupted = true;
         report.message = "interrupted in the verification rerun";
       }
-      if (!report.interrupted)
-        warn_of_verification(spec, options, *report.verification, largest_motion(trajectory),
-                             largest_turn(trajectory));
+      if (!report.interrupted) warn_of_verification(spec, options, *report.verification);
     }
   }
 
@@ -456,15 +451,15 @@ class Runner {
   }
 
   // A verification rerun farther from the run than kDriftTolerance times its tolerance: in the
-  // centres rtol x + atol, x the largest motion [m]; in the orientations rtol max(x, 1 rad) + atol
-  // radians, x the largest turn (every method weights a rotation absolutely, about rtol radians
-  // per step: a carriage tilting 3.7e-4 rad on a rail was 4.8e-8 rad off at rtol 1e-6, 129 rtol of
-  // its turn): the run is not within its tolerance and warns. The orientations only while no
-  // body turned past 3 rad: the measure is relative to the largest turn, at most pi, so a long
-  // spin's phase (the tumbling pair's 27 rad: about 3 rtol per radian turned) would read as tens
-  // of rtol whatever rtol; the centres still count there.
+  // centres rtol x + atol, x the rerun's largest motion [m]; in the orientations rtol max(x, 1 rad)
+  // + atol radians, x the largest angle a body of the rerun turned along its samples (every
+  // method weights a rotation absolutely, about rtol radians per step: a carriage tilting 3.7e-4
+  // rad on a rail was 4.8e-8 rad off at rtol 1e-6, 129 rtol of its turn; a spin's phase error
+  // grows with the angle turned: the tumbling pair's 27 rad, about 3 rtol per radian). The
+  // orientations only where successive samples are within kLongestSampledTurn (else a sample may
+  // have skipped a turn and the angle turned is not known); the centres still count there.
   void warn_of_verification(const AnalysisSpec& spec, const TransientOptions& options,
-                            const Verification& v, double motion, double turn) {
+                            const Verification& v) {
     const double rtol = options.integrator.rtol, atol = options.integrator.atol;
     if (!v.ok) {
       // A rerun that did not finish measured nothing (the run at rtol 1e-8 of a carriage with a
@@ -475,14 +470,14 @@ class Runner {
     }
     if (options.integrator.fixed_step > 0.0) return;
     std::string what;
-    if (motion > 0.0 && v.error > kDriftTolerance * (rtol + atol / motion))
+    if (v.motion > 0.0 && v.error > kDriftTolerance * (rtol + atol / v.motion))
       what = "the body centres by " + two_digits(v.error) + " of their motion (" +
              two_digits(v.error / rtol) + " rtol)";
-    if (turn > 0.0 && turn < kLongestTurn &&
-        v.rotation_error * turn > kDriftTolerance * (rtol * std::max(turn, 1.0) + atol))
+    const double angle = v.rotation_error * v.turn;  // [rad]
+    if (v.turned > 0.0 && angle > kDriftTolerance * (rtol * std::max(v.turned, 1.0) + atol))
       what += (what.empty() ? "" : " and ") + std::string("the orientations by ") +
-              two_digits(v.rotation_error) + " of their turn (" +
-              two_digits(v.rotation_error / rtol) + " rtol)";
+              two_digits(angle) + " rad (" + two_digits(angle / v.turned / rtol) + " rtol of the " +
+              two_digits(v.turned) + " rad turned)";
     if (what.empty()) return;
     add_warnings({"transient \"" + spec.name + "\": the verification rerun at rtol / 10 moved " +
                   what + ": the run is not within its tolerance; run it at a smaller rtol"});
@@ -561,11 +556,20 @@ class Runner {
   // steps held by its stiff modes' bounds, the same at rtol 1e-6 and 1e-7 on a bob on a joint of
   // compliance 1e-9) measured nothing, and a distance of 0 would claim an exact run: its steps
   // then set its error, as a fixed step's do, and a second rerun with steps at most half the
-  // run's mean step (t_end / `run_steps` / 2) measures it.
+  // run's mean step (t_end / its steps / 2) measures it.
   Verification rerun_tighter(const Model& model, const TransientOptions& options,
-                             const Trajectory& run, long run_steps) {
+                             const Trajectory& run, const SolverStats& run_stats) {
     Verification v;
-    TransientOptions tight = budgeted(options);
+    double seconds = 0.0;  // of the reruns so far
+    // The analysis's max_seconds holds the run and its reruns together.
+    const auto left = [&] {
+      return options.max_seconds > 0.0
+                 ? std::max(1e-3, options.max_seconds - run_stats.wall_seconds - seconds)
+                 : 0.0;
+    };
+    TransientOptions tight = options;
+    tight.max_seconds = left();
+    tight = budgeted(tight);
     if (tight.integrator.fixed_step > 0.0) {
       tight.integrator.fixed_step /= 2.0;
     } else {
@@ -575,7 +579,7 @@ class Runner {
     v.rtol = tight.integrator.rtol;
     v.atol = tight.integrator.atol;
     v.fixed_step = tight.integrator.fixed_step;
-    double seconds = 0.0;
+    bool repeated = false;
     const auto measure = [&] {
       Data data(model);
       Trajectory reference = trajectory_of(model, output_rows(options));
@@ -589,18 +593,21 @@ class Runner {
       v.stats.wall_seconds = seconds;  // of the reruns together
       v.error = r.ok ? trajectory_error(run, reference) : kNaN;
       v.rotation_error = r.ok ? trajectory_rotation_error(run, reference) : kNaN;
+      v.motion = largest_motion(reference);
+      v.turn = largest_turn(reference);
+      v.turned = largest_accumulated_turn(reference);
+      repeated = r.ok && same_samples(run, reference);
     };
-    const auto same = [&] { return v.ok && v.error == 0.0 && !(v.rotation_error > 0.0); };
     measure();
-    if (same() && !(tight.integrator.fixed_step > 0.0) && run_steps > 0) {
-      const double half = 0.5 * options.t_end / static_cast<double>(run_steps);
+    if (repeated && !(tight.integrator.fixed_step > 0.0) && run_stats.steps > 0) {
+      const double half = 0.5 * options.t_end / static_cast<double>(run_stats.steps);
       tight.integrator.max_step =
           tight.integrator.max_step > 0.0 ? std::min(tight.integrator.max_step, half) : half;
-      tight.max_seconds = budget_left(options.max_seconds);
+      tight.max_seconds = budget_left(left());
       v.max_step = tight.integrator.max_step;
       measure();
     }
-    if (same()) {
+    if (repeated) {
       v.error = v.rotation_error = kNaN;
       v.message =
           "the reruns gave the same states at every output: the run's error is not measured";

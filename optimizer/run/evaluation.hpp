@@ -33,8 +33,12 @@ struct Verification {
   double max_step = 0.0;
   double error = 0.0;           // largest body-centre distance between the runs / largest motion
   double rotation_error = 0.0;  // largest angle between the runs' orientations / largest turn
-  SolverStats stats;            // of the tighter run
-  std::string reason;           // why the run was verified: asked, or "verify": "auto"
+  // The tighter run's largest centre motion [m], largest turn [rad, at most pi] and largest turn
+  // along its samples [rad; NaN when its samples may have skipped a turn]: what the errors are
+  // measured against.
+  double motion = 0.0, turn = 0.0, turned = 0.0;
+  SolverStats stats;   // of the tighter run
+  std::string reason;  // why the run was verified: asked, or "verify": "auto"
 };
 
 struct AnalysisReport {

@@ -91,4 +91,25 @@ double largest_turn(const Trajectory& t) {
   return largest_from_start(t.orientations, t.bodies.size(), rotation_angle_between);
 }
 
+double largest_accumulated_turn(const Trajectory& t) {
+  const size_t nb = t.bodies.size();
+  double largest = 0.0;
+  for (size_t b = 0; b < nb; ++b) {
+    double turned = 0.0;
+    for (size_t k = 1; k < t.orientations.size() / nb; ++k) {
+      const double a =
+          rotation_angle_between(t.orientations[(k - 1) * nb + b], t.orientations[k * nb + b]);
+      if (!(a <= kLongestSampledTurn)) return std::numeric_limits<double>::quiet_NaN();
+      turned += a;
+    }
+    largest = std::max(largest, turned);
+  }
+  return largest;
+}
+
+bool same_samples(const Trajectory& a, const Trajectory& b) {
+  return a.bodies == b.bodies && a.times == b.times && a.positions == b.positions &&
+         a.orientations == b.orientations;
+}
+
 }  // namespace beamrail

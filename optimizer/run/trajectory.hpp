@@ -49,4 +49,14 @@ double trajectory_rotation_error(const Trajectory& run, const Trajectory& refere
 double largest_motion(const Trajectory& t);
 double largest_turn(const Trajectory& t);
 
+// The largest angle a body turned along its samples [rad]: the sum of the angles between its
+// successive orientations (a spin's whole turn, not capped at pi); NaN when two successive samples
+// are more than kLongestSampledTurn apart (they may then be a turn of 2 pi more), or an angle is
+// not finite.
+inline constexpr double kLongestSampledTurn = 3.0;  // [rad]
+double largest_accumulated_turn(const Trajectory& t);
+
+// Whether the two trajectories hold the same samples, bit for bit.
+bool same_samples(const Trajectory& a, const Trajectory& b);
+
 }  // namespace beamrail

@@ -195,6 +195,49 @@ TEST_F(MechanismVerification, ARerunThatFailsWarnsThatNothingWasMeasured) {
   EXPECT_TRUE(warned) << summary.dump(2);
 }
 
+// A rotor spinning freely at 5 rad/s on a revolute joint turns 10 rad in 2 s; its centre stays,
+// so only its orientation can be off. Its phase error grows with the angle turned, and the
+// verification weighs it against that angle (rtol x 10 rad + atol), not against the largest
+// angle between two orientations (at most pi). bdf at rtol 1e-6 is far off against the
+// closed form (a turn of 5 t about z: 20 times) and warns; orientations past 3 rad were once not
+// checked.
+TEST_F(MechanismVerification, ASpinsPhaseIsWeighedAgainstTheAngleTurned) {
+  Json s = Json::parse(R"({
+    "name": "rotor",
+    "scene": {
+      "gravity": [0, 0, 0],
+      "bodies": [{"name": "rotor", "mass": 2, "inertia": [0.01, 0.01, 0.02],
+                  "position": [0, 0, 0], "angular_velocity": [0, 0, 5]}],
+      "joints": [{"name": "axle", "type": "revolute", "body1": "ground", "body2": "rotor",
+                  "point": [0, 0, 0], "axis": [0, 0, 1]}]
+    },
+    "analyses": [{"type": "transient", "name": "spin", "t_end": 2.0, "output_step": 0.02,
+                  "integrator": {"method": "bdf", "rtol": 1e-6, "atol": 1e-9}}]
+  })");
+  run_ok(write_study("rotor.json", s), "rotor");
+  const Table run = read_table(dir_ / "rotor/spin.timeseries.csv");
+  double error = 0.0;  // the largest angle from the closed form's orientation [rad]
+  for (size_t i = 0; i < run.rows.size(); ++i) {
+    const double half = 2.5 * std::stod(run.at(i, "t"));  // (5 t) / 2
+    const double dot = std::abs(std::stod(run.at(i, "rotor.q0")) * std::cos(half) +
+                                std::stod(run.at(i, "rotor.q3")) * std::sin(half));
+    error = std::max(error, 2.0 * std::acos(std::min(1.0, dot)));
+  }
+  const double tolerance = 1e-6 * 10.0 + 1e-9;
+  const Json summary = load_json(dir_ / "rotor/summary.json");
+  const Json& v = summary["analyses"][0]["verification"];
+  std::printf(
+      "bdf, rtol 1e-6: %.3g rad off the closed form over 10 rad (%.1f times rtol x 10 rad "
+      "+ atol); the rerun: %s\n",
+      error, error / tolerance, v.dump().c_str());
+  EXPECT_GT(error, 10.0 * tolerance);
+  ASSERT_TRUE(summary.contains("warnings")) << summary.dump(2);
+  bool warned = false;
+  for (const Json& w : summary["warnings"])
+    warned = warned || w.get<std::string>().find("the orientations by") != std::string::npos;
+  EXPECT_TRUE(warned) << summary.dump(2);
+}
+
 TEST_F(MechanismVerification, AnythingElseIsBadInput) {
   Json s = bob({{"rtol", 1e-6}});
   s["analyses"][0]["verify"] = "sometimes";

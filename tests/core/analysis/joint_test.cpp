@@ -206,6 +206,43 @@ TEST(Joints, HangingPendulumSwingsAtItsSmallAngleFrequency) {
   EXPECT_GT(modal.modes[1].eigenvalue, 1e5 * exact);
 }
 
+// A joint's penalty stiffness does not depend on where the scene sits: the hanging pendulum
+// above, moved 1e4 m from the origin, has the same joint stiffness (the ground's "centre", the
+// origin, once gave its joint a lever of 1e4 m: 2e4 times softer, stretching 8 mm under the bob's
+// weight), and so the same frequency to the closed form's accuracy.
+TEST(Joints, AJointsStiffnessDoesNotDependOnWhereTheSceneSits) {
+  const double m = 1.0, d = 0.5, g = 9.81, ic = m * 4 * d * d / 12;
+  double omega2[2] = {0.0, 0.0}, k_force[2] = {0.0, 0.0}, k_moment[2] = {0.0, 0.0};
+  for (int far = 0; far < 2; ++far) {
+    const Vec3 at = far ? Vec3(1e4, 0, 0) : Vec3::Zero();
+    Scene s;
+    s.j["gravity"] = vec(0, -g, 0);
+    s.body("bob", m, Vec3(ic, ic, ic), at + Vec3(0, -d, 0));
+    s.j["joints"] = Json::array({joint("pivot", "revolute", "ground", "bob", at)});
+    s.j["joints"][0]["axis"] = vec(0, 0, 1);
+    const Model model = s.model();
+    ASSERT_EQ(model.joints.size(), 1u);
+    k_force[far] = model.joints[0].k_force;
+    k_moment[far] = model.joints[0].k_moment;
+    Data data(model);
+    ASSERT_TRUE(solve_static(model, StaticOptions{}, data).ok);
+    ModalOptions options;
+    options.modes = 1;
+    const ModalResult modal = solve_modal(model, options, data);
+    ASSERT_GE(modal.modes.size(), 1u) << modal.message;
+    omega2[far] = modal.modes[0].eigenvalue;
+  }
+  const double exact = m * g * d / (ic + m * d * d);
+  std::printf(
+      "joint stiffness at the origin %.6e N/m, 1e4 m away %.6e N/m; omega^2 %.10f and "
+      "%.10f (exact %.10f)\n",
+      k_force[0], k_force[1], omega2[0], omega2[1], exact);
+  EXPECT_EQ(k_force[1], k_force[0]);
+  EXPECT_EQ(k_moment[1], k_moment[0]);
+  EXPECT_LT(std::abs(omega2[1] - exact) / exact, 10 * 1e-6);
+  EXPECT_LT(std::abs(omega2[0] - exact) / exact, 10 * 1e-6);
+}
+
 // --- (b) A pinned-pinned Euler column built with revolute joints -------------------------------
 
 // A steel column along x (L = 1 m, bending as a 10 mm square, 100 times its area: Euler's load

@@ -417,7 +417,8 @@ class Runner {
     add_warnings({"transient \"" + spec.name + "\": the energy changed by " + two_digits(ratio) +
                   " of the largest kinetic + elastic energy (" + two_digits(ratio / rtol) +
                   " rtol) in a scene that keeps it (no loads, no damping): the motion may be "
-                  "off by more than rtol; \"verify\": true measures it"});
+                  "off by more than rtol; \"verify\": true measures it (a mechanism is verified by "
+                  "default)"});
   }
 
   // Why the transient is verified (summary.json verification.reason), "" when it is not: asked

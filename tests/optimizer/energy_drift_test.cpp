@@ -86,7 +86,7 @@ double figure_before(const std::vector<std::string>& warnings, const std::string
   for (const std::string& w : warnings) {
     if (w.find(text) == std::string::npos) continue;
     const size_t end = w.find(unit, w.find(text));
-    const size_t begin = w.rfind('(', end);
+    const size_t begin = end == std::string::npos ? end : w.find_last_of("( ", end - 1);
     if (end == std::string::npos || begin == std::string::npos) return NAN;
     return std::stod(w.substr(begin + 1, end - begin - 1));
   }

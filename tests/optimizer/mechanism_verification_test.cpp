@@ -120,6 +120,15 @@ TEST_F(MechanismVerification, AStiffJointBobVerifiesItselfAndWarnsWhereItIsOff) 
   // ... and says so, with an estimate of the right size (the rerun is off itself: 9e-5 of the
   // motion at rtol 1e-9).
   EXPECT_TRUE(warns_off_tolerance(off)) << off.dump(2);
+  // The warning quotes the estimate in multiples of the tolerance, which decides (140; its rtol
+  // figure, 1.8e4, is large because atol dominates the tolerance of a 78 um motion).
+  double quoted = 0.0;
+  for (const Json& w : off["warnings"]) {
+    const std::string text = w.get<std::string>();
+    const size_t end = text.find(" times their tolerance");
+    if (end != std::string::npos) quoted = std::stod(text.substr(text.rfind('(', end) + 1));
+  }
+  EXPECT_NEAR(quoted, estimate / tolerance, 0.05 * estimate / tolerance);
   EXPECT_GT(estimate, tight.error / 3.0);
   EXPECT_LT(estimate, 3.0 * tight.error);
 

@@ -1,20 +1,17 @@
 // A mechanism's transient verifies itself by default ("verify": "auto"): where bodies move as a
 // mechanism every method's error control was found silently off (README "Mechanisms verify
 // themselves"), so such a run is rerun at rtol / 10 and warns when the two are farther apart than
-// 10 times its tolerance. The scene is the worst case found: a 1 kg bob 0.3 m below a revolute
-// joint of compliance 1e-9, at rest, under a 1e-3 N m torque sin(4 pi t), for 1 s. Its closed
-// form (small swings: sin theta = theta to 1e-8 of the motion): I theta'' + m g L theta =
-// T sin(W t), I = m L^2 + I_c, from rest, so theta = T / (I (w^2 - W^2)) (sin W t - (W / w) sin
-// w t), w^2 = m g L / I, and the bob's centre is at x = L sin theta.
+// 10 times its tolerance. The scene is the worst case found: the stiff-joint bob of
+// tests/support/stiff_joint_bob.hpp, for 1 s.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
-#include <numbers>
 #include <string>
 
+#include "tests/support/stiff_joint_bob.hpp"
 #include "tests/support/study_runs.hpp"
 
 namespace beamrail {
@@ -25,34 +22,13 @@ using testing::load_json;
 using testing::read_table;
 using testing::Table;
 
-constexpr double kMass = 1.0, kArm = 0.3, kOwnInertia = 1e-3, kTorque = 1e-3, kGravity = 9.81;
-constexpr double kLoadRate = 4.0 * std::numbers::pi;  // 2 Hz [rad/s]
-
 Json bob(const Json& integrator) {
-  Json s = Json::parse(R"({
-    "name": "bob",
-    "scene": {
-      "gravity": [0, -9.81, 0],
-      "bodies": [{"name": "bob", "mass": 1, "inertia": [0.001, 0.001, 0.001],
-                  "position": [0, -0.3, 0]}],
-      "joints": [{"name": "pivot", "type": "revolute", "body1": "ground", "body2": "bob",
-                  "point": [0, 0, 0], "axis": [0, 0, 1], "relative_compliance": 1e-9}],
-      "loads": [{"type": "torque", "body": "bob", "value": [0, 0, 0.001],
-                 "time": {"type": "harmonic", "frequency": 2}}]
-    },
-    "analyses": [{"type": "transient", "name": "swing", "t_end": 1.0, "output_step": 0.005}]
-  })");
+  Json s = {{"name", "bob"},
+            {"scene", Json::parse(testing::stiff_joint_bob())},
+            {"analyses", Json::parse(R"([{"type": "transient", "name": "swing", "t_end": 1.0,
+                                         "output_step": 0.005}])")}};
   s["analyses"][0]["integrator"] = integrator;
   return s;
-}
-
-// The closed form's x of the bob's centre at t [m].
-double closed_form_x(double t) {
-  const double inertia = kMass * kArm * kArm + kOwnInertia;
-  const double w = std::sqrt(kMass * kGravity * kArm / inertia), W = kLoadRate;
-  const double theta =
-      kTorque / (inertia * (w * w - W * W)) * (std::sin(W * t) - W / w * std::sin(w * t));
-  return kArm * std::sin(theta);
 }
 
 struct Measured {
@@ -63,7 +39,7 @@ struct Measured {
 Measured against_closed_form(const Table& run) {
   Measured m;
   for (size_t i = 0; i < run.rows.size(); ++i) {
-    const double t = std::stod(run.at(i, "t")), x = closed_form_x(t);
+    const double t = std::stod(run.at(i, "t")), x = testing::stiff_joint_bob_x(t);
     m.error = std::max(m.error, std::abs(std::stod(run.at(i, "bob.x")) - x));
     m.motion = std::max(m.motion, std::abs(x));
   }

@@ -13,30 +13,36 @@
 
 namespace beamrail::testing {
 
+// The bob's parameters, shared by the scene and its closed form.
+inline constexpr double kBobMass = 1.0, kBobArm = 0.3, kBobOwnInertia = 1e-3, kBobTorque = 1e-3;
+inline constexpr double kBobGravity = 9.81, kBobLoadHz = 2.0;
+
 // The scene JSON text, the joint at `pivot` [m].
 inline std::string stiff_joint_bob(const std::array<double, 3>& pivot = {0.0, 0.0, 0.0}) {
-  const auto at = [](double x, double y, double z) {
-    return "[" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) + "]";
+  const auto n = [](double v) { return std::to_string(v); };
+  const auto at = [&n](double x, double y, double z) {
+    return "[" + n(x) + ", " + n(y) + ", " + n(z) + "]";
   };
-  return R"({"gravity": [0, -9.81, 0],
-    "bodies": [{"name": "bob", "mass": 1, "inertia": [0.001, 0.001, 0.001], "position": )" +
-         at(pivot[0], pivot[1] - 0.3, pivot[2]) + R"(}],
+  return R"({"gravity": [0, )" + n(-kBobGravity) + R"(, 0],
+    "bodies": [{"name": "bob", "mass": )" +
+         n(kBobMass) + R"(, "inertia": )" + at(kBobOwnInertia, kBobOwnInertia, kBobOwnInertia) +
+         R"(, "position": )" + at(pivot[0], pivot[1] - kBobArm, pivot[2]) + R"(}],
     "joints": [{"name": "pivot", "type": "revolute", "body1": "ground", "body2": "bob",
                 "point": )" +
          at(pivot[0], pivot[1], pivot[2]) + R"(, "axis": [0, 0, 1], "relative_compliance": 1e-9}],
-    "loads": [{"type": "torque", "body": "bob", "value": [0, 0, 0.001],
-               "time": {"type": "harmonic", "frequency": 2}}]})";
+    "loads": [{"type": "torque", "body": "bob", "value": )" +
+         at(0.0, 0.0, kBobTorque) + R"(, "time": {"type": "harmonic", "frequency": )" +
+         n(kBobLoadHz) + R"(}}]})";
 }
 
 // The closed form's x of the bob's centre at t, from the joint [m].
 inline double stiff_joint_bob_x(double t) {
-  constexpr double kMass = 1.0, kArm = 0.3, kOwnInertia = 1e-3, kTorque = 1e-3, kGravity = 9.81;
-  constexpr double kLoadRate = 4.0 * std::numbers::pi;  // 2 Hz [rad/s]
-  const double inertia = kMass * kArm * kArm + kOwnInertia;
-  const double w = std::sqrt(kMass * kGravity * kArm / inertia), W = kLoadRate;
+  const double inertia = kBobMass * kBobArm * kBobArm + kBobOwnInertia;
+  const double w = std::sqrt(kBobMass * kBobGravity * kBobArm / inertia);
+  const double W = 2.0 * std::numbers::pi * kBobLoadHz;
   const double theta =
-      kTorque / (inertia * (w * w - W * W)) * (std::sin(W * t) - W / w * std::sin(w * t));
-  return kArm * std::sin(theta);
+      kBobTorque / (inertia * (w * w - W * W)) * (std::sin(W * t) - W / w * std::sin(w * t));
+  return kBobArm * std::sin(theta);
 }
 
 }  // namespace beamrail::testing

@@ -313,14 +313,14 @@ class AutoIntegrator : public Integrator {
   }
 
   // The modes a chosen band kept quasi-static carry inertia the run would lose: the run goes on
-  // from (t, y) with every mode, or above kModalIntegratorMaxDofs with a band kAutoBandWidening
+  // from (t, y) with every mode, or above kModalDenseBandMaxDofs with a band kAutoBandWidening
   // times wider, linearized about this state; false (failure_ set) when no modal method starts
   // and dirk does not either.
   bool widen_band(double t, N_Vector y) {
     QuasiStaticInertia q;
     modal_quasi_static_inertia(*current_, &q);
     before_ = sum(before_, current_->stats());
-    const bool every = context_->model.n_dofs <= kModalIntegratorMaxDofs;
+    const bool every = context_->model.n_dofs <= kModalDenseBandMaxDofs;
     const double hz = every ? 0.0 : kAutoBandWidening * q.band_hz;
     const std::string why = "the modes above the " + number(q.band_hz) +
                             " Hz band, kept quasi-static, moved with " + number(q.ratio) +

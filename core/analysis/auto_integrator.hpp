@@ -5,8 +5,8 @@
 //   damping that couples its modes damps beyond kAutoMaxDampingRatio of the fastest mode's
 //   critical damping (each mode's own damping is exact in the modal method, the coupling
 //   explicit): then bdf, as before auto. From kAutoChosenBandDofs on, the modal method's band is
-//   chosen for rtol (core/analysis/modal_band.hpp); bdf when no band of the modes it may ask for
-//   meets rtol.
+//   chosen for rtol (core/analysis/modal_band.hpp); when no band of the modes it may ask for
+//   meets rtol, every mode up to kModalIntegratorMaxDofs, else bdf.
 // - When a body turns more than kAutoRelinearizeRotation (less after cheap relinearizations,
 //   below) from the orientation it is linearized about, the modal method is linearized again about
 //   the current state (one eigenproblem) and the run goes on; when that happens more often than
@@ -23,7 +23,7 @@
 // - A band it chose itself (for rtol) is widened when the inertia of the modes it keeps
 //   quasi-static (their motion at second order: core/analysis/modal_integrator.hpp,
 //   QuasiStaticInertia) is estimated to move the run by kAutoInertiaShare of what rtol leaves:
-//   from that step on, every mode (up to kModalIntegratorMaxDofs) or a band kAutoBandWidening
+//   from that step on, every mode (up to kModalDenseBandMaxDofs) or a band kAutoBandWidening
 //   times wider, linearized about that state. A band given in max_frequency_hz is the user's
 //   model: it is kept, and the run warns instead.
 //
@@ -102,7 +102,7 @@ inline constexpr int kAutoChosenBandDofs = 600;
 // left of rtol (rtol less the drift of the phases before): the drift already run stays in the
 // result, so the run's sum stays below rtol.
 inline constexpr double kAutoInertiaShare = 0.5;
-// Above kModalIntegratorMaxDofs, the band's top frequency is multiplied by this.
+// Above kModalDenseBandMaxDofs, the band's top frequency is multiplied by this.
 inline constexpr double kAutoBandWidening = 4.0;
 
 // The auto integrator for the system in `context`, starting at (0, y0).

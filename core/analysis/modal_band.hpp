@@ -105,7 +105,7 @@ std::vector<BandExcitation> band_excitations(const Model& model, const Data& dat
                                              double horizon = 0.0);
 
 // The modes of a band-limited run (core/analysis/modal_integrator.hpp): from the dense eigensolver
-// up to kModalIntegratorMaxDofs degrees of freedom, else from shift-invert Lanczos asked for more
+// up to kModalDenseBandMaxDofs degrees of freedom, else from shift-invert Lanczos asked for more
 // modes until one lies above the band or, for a band chosen for rtol (band_hz 0), until the band
 // meets rtol (at most kModalChosenBandMaxModes modes). k0 and m0: the symmetric tangent stiffness
 // and the mass of the linearization posed in `data`; `excitations` and `watched` as for

@@ -249,7 +249,7 @@ class ModalExponential : public Integrator {
     return false;
   }
 
-  // The modes of the band (dense eigensolver up to kModalIntegratorMaxDofs, else shift-invert
+  // The modes of the band (dense eigensolver up to kModalDenseBandMaxDofs, else shift-invert
   // Lanczos asked for more modes until one lies above the band or, when the band is chosen
   // (options_.choose_band, core/analysis/modal_band.hpp), until the band meets rtol) and, when
   // some lie above, the factored K0 of the static correction. The linearization is posed in

@@ -43,7 +43,7 @@
 // core/analysis/modal_step_bounds.hpp.
 //
 // Band-limited (IntegratorOptions::max_frequency_hz): only the m modes up to the band are
-// integrated (from the dense eigensolver, or above kModalIntegratorMaxDofs from shift-invert
+// integrated (from the dense eigensolver, or above kModalDenseBandMaxDofs from shift-invert
 // Lanczos, core/analysis/modal_analysis.hpp); the others are quasi-static: x = Phi z + y, y
 // M0-orthogonal to the modes kept and such that the accelerations have no part outside the band
 // (y is the static response of the modes above the band to everything the linear part leaves
@@ -64,9 +64,16 @@
 
 namespace beamrail {
 
-// Largest scene the modal integrator accepts [degrees of freedom = 6 per free body].
-inline constexpr int kModalIntegratorMaxDofs = 1200;
-// Most modes a chosen band (IntegratorOptions::choose_band) asks the sparse eigensolver for.
+// Largest scene the modal integrator integrates every mode of [degrees of freedom = 6 per free
+// body]: one dense eigenproblem at set-up (~n^3) and products with the n x n basis (~n^2 per
+// stage); above it only a band (max_frequency_hz). Measured where auto takes it because no band
+// meets rtol: README "Every mode where no band meets rtol".
+inline constexpr int kModalIntegratorMaxDofs = 2400;
+// Up to this many degrees of freedom a band's modes come from the dense eigensolver, above from
+// shift-invert Lanczos (core/analysis/modal_band.hpp).
+inline constexpr int kModalDenseBandMaxDofs = 1200;
+// Most modes a chosen band (IntegratorOptions::choose_band) asks the sparse eigensolver for; when
+// none meets rtol, up to kModalIntegratorMaxDofs the dense eigensolver gives every mode.
 inline constexpr int kModalChosenBandMaxModes = 400;
 // Largest rotation of a body from the orientation it is linearized about that the method follows
 // [rad].

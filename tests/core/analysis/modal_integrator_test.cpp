@@ -336,7 +336,7 @@ TEST(ModalIntegrator, RefusesScenesAboveItsSizeLimit) {
   ASSERT_GT(model.n_dofs, kModalIntegratorMaxDofs);
   const TransientRun run = simulate(model, modal(1e-3, 1e-3, 1e-6, 1e-9));
   EXPECT_FALSE(run.result.ok);
-  EXPECT_NE(run.result.message.find("up to 200 free bodies"), std::string::npos)
+  EXPECT_NE(run.result.message.find("up to 400 free bodies"), std::string::npos)
       << run.result.message;
   EXPECT_TRUE(run.samples.empty());
 }

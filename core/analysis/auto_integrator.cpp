@@ -216,7 +216,8 @@ class AutoIntegrator : public Integrator {
                  (modal_frame_rate(*current_) > 0.0 ? " (in the frame turning with its part)"
                                                     : std::string()) +
                  ": relinearized about this state" +
-                 (choose_band_ ? "; " + modal_band_choice(*current_) : std::string()));
+                 (choose_band_ ? "; " + modal_band_choice(*current_) : std::string()),
+             true);
     }
   }
 
@@ -393,8 +394,9 @@ class AutoIntegrator : public Integrator {
     return true;
   }
 
-  void record(double t, const std::string& method, const std::string& reason) {
-    MethodPhase p{t, method, reason};
+  void record(double t, const std::string& method, const std::string& reason,
+              bool relinearized = false) {
+    MethodPhase p{t, method, reason, relinearized};
     if (first_.size() + 1 < kMaxRecordedPhases)
       first_.push_back(std::move(p));
     else

@@ -119,8 +119,9 @@ struct SolverStats {
 // one phase).
 struct MethodPhase {
   double t = 0.0;
-  std::string method;  // "modal", "modal (relinearized)", "bdf", "dirk ESDIRK547L2SA2_7_4_5"
+  std::string method;  // "modal", "bdf", "dirk ESDIRK547L2SA2_7_4_5", ...
   std::string reason;
+  bool relinearized = false;  // a modal phase linearized again as a body turned its limit
 };
 
 struct TransientResult {

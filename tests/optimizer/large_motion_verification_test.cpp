@@ -22,6 +22,7 @@ using Json = nlohmann::json;
 using testing::load_json;
 using testing::read_table;
 using testing::Table;
+using testing::warns_off_tolerance;
 
 Json l_frame(double speed, const Json& integrator) {
   Json s = Json::parse(R"({
@@ -91,14 +92,6 @@ Deviation deviation(const Table& run, const Table& reference) {
     d.turned = std::max(d.turned, turned);
   }
   return d;
-}
-
-bool warns_off_tolerance(const Json& summary) {
-  if (!summary.contains("warnings")) return false;
-  for (const Json& w : summary["warnings"])
-    if (w.get<std::string>().find("the run is not within its tolerance") != std::string::npos)
-      return true;
-  return false;
 }
 
 class LargeMotionVerification : public testing::StudyRuns {};

@@ -21,6 +21,7 @@ using Json = nlohmann::json;
 using testing::load_json;
 using testing::read_table;
 using testing::Table;
+using testing::warns_off_tolerance;
 
 Json bob(const Json& integrator) {
   Json s = {{"name", "bob"},
@@ -44,14 +45,6 @@ Measured against_closed_form(const Table& run) {
     m.motion = std::max(m.motion, std::abs(x));
   }
   return m;
-}
-
-bool warns_off_tolerance(const Json& summary) {
-  if (!summary.contains("warnings")) return false;
-  for (const Json& w : summary["warnings"])
-    if (w.get<std::string>().find("the run is not within its tolerance") != std::string::npos)
-      return true;
-  return false;
 }
 
 class MechanismVerification : public testing::StudyRuns {

@@ -195,4 +195,14 @@ inline nlohmann::json tube_grid(const std::filesystem::path& studies, int n_d, i
   return s;
 }
 
+// Whether a summary warns that its transient is not within its tolerance (a verification rerun
+// farther from the run than 10 times its tolerance).
+inline bool warns_off_tolerance(const nlohmann::json& summary) {
+  if (!summary.contains("warnings")) return false;
+  for (const nlohmann::json& w : summary["warnings"])
+    if (w.get<std::string>().find("the run is not within its tolerance") != std::string::npos)
+      return true;
+  return false;
+}
+
 }  // namespace beamrail::testing

@@ -314,7 +314,7 @@ class Runner {
     if (table) report.tables = {file};
 
     std::string verification = verification_reason(spec, model, options);
-    // auto may yet leave its linearization (verified_after_the_run): the trajectory is kept.
+    // auto may yet relinearize (verified_after_the_run): the trajectory is kept.
     const bool verify = !verification.empty() || may_verify_after_the_run(spec, options);
     Trajectory trajectory = trajectory_of(model, output_rows(options));
     bool first = true;
@@ -463,7 +463,7 @@ class Runner {
   // against Verner at rtol 1e-11, warned only of its model (the beams' axial forces), and its
   // reruns measured 13 / 1,022 (README "Large motions verify themselves"). Not where auto only
   // handed over to another method after a failed modal phase: a 100-segment cantilever whose band
-  // failed at 3 us ran dirk, and its rerun at rtol 1e-7 was itself 20 times farther off than the
+  // failed at 3 us ran dirk, and its rerun at rtol 1e-7 was itself 21 times farther off than the
   // run (a false alarm).
   static std::string verified_after_the_run(const AnalysisSpec& spec,
                                             const TransientOptions& options,

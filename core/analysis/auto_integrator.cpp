@@ -149,7 +149,7 @@ class AutoIntegrator : public Integrator {
           if (!widen(
                   *t, y,
                   "the modal method failed in the band it chose (" + current_->failure(flag) + ")",
-                  true, false))
+                  0.0, false))
             return kAutoFailed;
           continue;
         }
@@ -339,15 +339,14 @@ class AutoIntegrator : public Integrator {
                             " of its kinetic energy (inertia the band leaves out: an error "
                             "estimated at " +
                             number(q.drift) + " of the motion by t = " + number(t) + " s)";
-    return widen(t, y, why, every, true, kAutoBandWidening * q.band_hz);
+    return widen(t, y, why, every ? 0.0 : kAutoBandWidening * q.band_hz, true);
   }
 
-  // Goes on from (t, y) with every mode (`every`) or a band of `hz`, linearized about this state,
-  // starting at the last phase's step (`same_pace`) or its own; false (failure_ set) when no modal
-  // method starts and dirk does not either.
-  bool widen(double t, N_Vector y, const std::string& why, bool every, bool same_pace,
-             double hz = 0.0) {
-    if (every) hz = 0.0;
+  // Goes on from (t, y) with a band of `hz` (0: every mode), linearized about this state, starting
+  // at the last phase's step (`same_pace`) or its own; false (failure_ set) when no modal method
+  // starts and dirk does not either.
+  bool widen(double t, N_Vector y, const std::string& why, double hz, bool same_pace) {
+    const bool every = !(hz > 0.0);
     before_ = sum(before_, current_->stats());
     choose_band_ = false;
     widened_ = true;

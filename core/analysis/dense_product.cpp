@@ -49,7 +49,12 @@ int threads_for(long rows, long cols, long parts) {
 // of the pair on the AVX-512 machine (a standalone copy, medians of 15): two partial sums per
 // vector, 16 columns per block, 16 rows per step took 7.1 to 9.1 us against 7.2 at n = 240 (in
 // L2) and 153 to 157 against 162 us at n = 1,040: about 16 and 14 GFMA/s, near what its FMA
-// units give at the 2.4 to 3.4 GHz this machine runs at. Kept as it is.
+// units give at the 2.4 to 3.4 GHz this machine runs at. Kept as it is. Three pairs in one pass
+// on the AVX2 machine (n = 1,038; a standalone driver of this file, medians of 21, three rounds
+// each, 2026-11-30): in 8 lanes (two registers each, 48 broadcasts) 760 to 786 us against 583
+// to 756 us for three pair passes; in 4 lanes 815 to 877 us as GCC at -O3 compiles the loops
+// over the vectors and the block's columns, 487 to 526 us with them unrolled by pragma. So AVX2
+// takes one pass too, in 4 lanes, unrolled.
 constexpr int kBlock = 8;
 
 template <int kVectors>
@@ -66,16 +71,22 @@ template <int kVectors, int kLanes>
   typedef double Lanes __attribute__((vector_size(8 * kLanes)));
   const long body = rows - rows % kLanes;
   double p[kVectors][kBlock];
+#pragma GCC unroll 8
   for (int v = 0; v < kVectors; ++v)
+#pragma GCC unroll 8
     for (int j = 0; j < kBlock; ++j) p[v][j] = x[v * cols + k + j];
   for (long i = 0; i < body; i += kLanes) {
     Lanes s[kVectors];
+#pragma GCC unroll 8
     for (int v = 0; v < kVectors; ++v) std::memcpy(&s[v], y + v * ldy + i, sizeof(Lanes));
+#pragma GCC unroll 8
     for (int j = 0; j < kBlock; ++j) {
       Lanes c;
       std::memcpy(&c, col + j * lda + i, sizeof c);
+#pragma GCC unroll 8
       for (int v = 0; v < kVectors; ++v) s[v] += p[v][j] * c;
     }
+#pragma GCC unroll 8
     for (int v = 0; v < kVectors; ++v) std::memcpy(y + v * ldy + i, &s[v], sizeof(Lanes));
   }
   for (long i = body; i < rows; ++i)
@@ -171,7 +182,7 @@ template <int kVectors, int kLanes>
 #define BEAMRAIL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #define BEAMRAIL_AVX512 __attribute__((target("avx512f")))
 // The environment variable BEAMRAIL_PRODUCTS_WITHOUT_AVX512 (any value) takes the kernels of a
-// machine without AVX-512 on one that has it (the pair in 4 lanes, three pair passes): the tests
+// machine without AVX-512 on one that has it (the kernels in 4 lanes): the tests
 // run both wherever they run.
 bool has_avx512() {
   static const bool avx512 =
@@ -204,9 +215,20 @@ void pair_kernel(long rows, long cols, const double* a, long lda, const double* 
   (has_avx512() ? pair_kernel_avx512 : pair_kernel_avx2)(rows, cols, a, lda, x, y, ldy);
 }
 
-BEAMRAIL_CLONES void six_kernel(long rows, long cols, const double* a, long lda, const double* x,
-                                double* y, long ldy) {
-  wide_kernel<6>(rows, cols, a, lda, x, y, ldy);
+// Three pairs in one pass: in 8 lanes where the CPU has AVX-512, in 4 else.
+BEAMRAIL_AVX512 void six_kernel_avx512(long rows, long cols, const double* a, long lda,
+                                       const double* x, double* y, long ldy) {
+  wide_kernel<6, 8>(rows, cols, a, lda, x, y, ldy);
+}
+
+BEAMRAIL_CLONES void six_kernel_avx2(long rows, long cols, const double* a, long lda,
+                                     const double* x, double* y, long ldy) {
+  wide_kernel<6, 4>(rows, cols, a, lda, x, y, ldy);
+}
+
+void six_kernel(long rows, long cols, const double* a, long lda, const double* x, double* y,
+                long ldy) {
+  (has_avx512() ? six_kernel_avx512 : six_kernel_avx2)(rows, cols, a, lda, x, y, ldy);
 }
 
 BEAMRAIL_CLONES void vector_kernel(long rows, long cols, const double* a, long lda, const double* x,
@@ -242,10 +264,22 @@ void transposed_then_pair_kernel(long rows, long cols, const double* a, const do
                                                                            fill, context, x, y);
 }
 
-BEAMRAIL_CLONES void transposed_then_six_kernel(long rows, long cols, const double* a,
+BEAMRAIL_AVX512 void transposed_then_six_avx512(long rows, long cols, const double* a,
                                                 const double* g, double* t, ProjectionFill fill,
                                                 void* context, const double* x, double* y) {
   transposed_then<6, 8>(rows, cols, a, g, t, fill, context, x, y);
+}
+
+BEAMRAIL_CLONES void transposed_then_six_avx2(long rows, long cols, const double* a,
+                                              const double* g, double* t, ProjectionFill fill,
+                                              void* context, const double* x, double* y) {
+  transposed_then<6, 4>(rows, cols, a, g, t, fill, context, x, y);
+}
+
+void transposed_then_six_kernel(long rows, long cols, const double* a, const double* g, double* t,
+                                ProjectionFill fill, void* context, const double* x, double* y) {
+  (has_avx512() ? transposed_then_six_avx512 : transposed_then_six_avx2)(rows, cols, a, g, t, fill,
+                                                                         context, x, y);
 }
 
 using Kernel = void (*)(long, long, const double*, long, const double*, double*, long);
@@ -288,20 +322,10 @@ void multiply_pair(const Eigen::MatrixXd& a, const double* x, double* y) {
   in_row_blocks(pair_kernel, a, x, y);
 }
 
-bool three_pairs_in_one_pass() {
-  // One pass where the six partial sums fit the registers (AVX-512); three pair passes else: on
-  // an AVX2 machine (AMD EPYC, medians of 3 of tests/benchmarks/products_benchmark) one pass took
-  // 827 us at n = 1,038 and three 690 us, 51 and 37 us at n = 240, 425 and 363 us at 6,000 x 95.
-  return has_avx512();
-}
+bool products_in_avx512() { return has_avx512(); }
 
 void multiply_three_pairs(const Eigen::MatrixXd& a, const double* x, double* y) {
-  if (three_pairs_in_one_pass()) {
-    in_row_blocks(six_kernel, a, x, y);
-    return;
-  }
-  for (int k = 0; k < 3; ++k)
-    in_row_blocks(pair_kernel, a, x + 2 * a.cols() * k, y + 2 * a.rows() * k);
+  in_row_blocks(six_kernel, a, x, y);
 }
 
 void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y) {
@@ -342,15 +366,10 @@ void multiply_transposed_then(const Eigen::MatrixXd& a, const double* g, double*
       multiply_three_pairs(a, x, y);
     return;
   }
-  if (vectors == 2) {
+  if (vectors == 2)
     transposed_then_pair_kernel(rows, cols, a.data(), g, t, fill, context, x, y);
-  } else if (three_pairs_in_one_pass()) {
+  else
     transposed_then_six_kernel(rows, cols, a.data(), g, t, fill, context, x, y);
-  } else {
-    // Without AVX-512 the first pair on the way, the other two in pair passes.
-    transposed_then_pair_kernel(rows, cols, a.data(), g, t, fill, context, x, y);
-    for (int k = 1; k < 3; ++k) in_row_blocks(pair_kernel, a, x + 2 * cols * k, y + 2 * rows * k);
-  }
 }
 
 long products_on_threads() { return products_shared.load(); }

@@ -50,10 +50,12 @@ int largest_product_team();
 void multiply_pair(const Eigen::MatrixXd& a, const double* x, double* y);
 
 // y = a x for x (a.cols() x 6) and y (a.rows() x 6), column-major: three pairs (a trial step's
-// new state and its two error estimates), in one pass over a where the CPU has AVX-512, as three
-// pair products else (three_pairs_in_one_pass).
+// new state and its two error estimates) in one pass over a.
 void multiply_three_pairs(const Eigen::MatrixXd& a, const double* x, double* y);
-bool three_pairs_in_one_pass();
+
+// Whether the products run their kernels in AVX-512's 8 lanes (else in AVX2's 4, or the
+// compiler's default; BEAMRAIL_PRODUCTS_WITHOUT_AVX512 takes those where the CPU has AVX-512).
+bool products_in_avx512();
 
 // y = a x for the vectors x (length a.cols()) and y (length a.rows()).
 void multiply_vector(const Eigen::MatrixXd& a, const double* x, double* y);

@@ -123,9 +123,8 @@ TEST(DenseProduct, ThreadsGiveTheSameBits) {
       const Products shared = products(threads);
       const std::string label = std::to_string(rows) + " x " + std::to_string(cols) + ", " +
                                 std::to_string(threads) + " threads";
-      // pair, vector and the three pairs (one product, or three: three_pairs_in_one_pass) by rows.
-      const int by_rows = three_pairs_in_one_pass() ? 3 : 5;
-      EXPECT_EQ(shared.shared, by_rows * shape.rows_shared + shape.columns_shared) << label;
+      // pair, vector and the three pairs (one product) by rows.
+      EXPECT_EQ(shared.shared, 3 * shape.rows_shared + shape.columns_shared) << label;
       EXPECT_TRUE(shared.pair == serial.pair) << label << " (pair)";
       EXPECT_TRUE(shared.six == serial.six) << label << " (three pairs)";
       EXPECT_TRUE(shared.one == serial.one) << label << " (vector)";
@@ -200,9 +199,9 @@ TEST(DenseProduct, TransposedThenProductGivesTheBitsOfTwoProducts) {
       }
 }
 
-// Without BEAMRAIL_PRODUCTS_WITHOUT_AVX512 the three pairs take one pass where the CPU has
-// AVX-512; with it (the test dense_product_test.KernelsWithoutAvx512 of tests/CMakeLists.txt runs
-// this program so) three pair passes with the pair in 4 lanes, as on a machine without AVX-512.
+// Without BEAMRAIL_PRODUCTS_WITHOUT_AVX512 the products run in AVX-512's 8 lanes where the CPU
+// has it; with it (the test dense_product_test.KernelsWithoutAvx512 of tests/CMakeLists.txt runs
+// this program so) in 4 lanes, as on a machine without AVX-512.
 TEST(DenseProduct, TheEnvironmentTakesTheKernelsWithoutAvx512) {
   const bool without = std::getenv("BEAMRAIL_PRODUCTS_WITHOUT_AVX512") != nullptr;
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && \
@@ -212,8 +211,8 @@ TEST(DenseProduct, TheEnvironmentTakesTheKernelsWithoutAvx512) {
   const bool avx512 = false;
 #endif
   std::printf("AVX-512 %s, kernels %s\n", avx512 ? "present" : "absent",
-              three_pairs_in_one_pass() ? "with it" : "without it");
-  EXPECT_EQ(three_pairs_in_one_pass(), avx512 && !without);
+              products_in_avx512() ? "with it" : "without it");
+  EXPECT_EQ(products_in_avx512(), avx512 && !without);
 }
 
 }  // namespace

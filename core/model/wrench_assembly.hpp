@@ -11,9 +11,11 @@
 namespace beamrail {
 
 // The load's force or torque at time t, scaled by load_factor, in global axes in the pose given
-// (a follower load's body-axes value turned by pose.A).
+// (a follower load's body-axes value turned by pose.A). Zero at load_factor 0 whatever the time
+// (a harmonic load has no final value: NaN at t = infinity, which 0 would not cancel).
 template <class S>
 Vec3T<S> load_value(const LoadT<S>& load, const Pose<S>& pose, double t, double load_factor = 1.0) {
+  if (load_factor == 0.0) return Vec3T<S>::Zero();
   const Vec3T<S> value = (load_factor * load.time(t)) * load.value;
   return load.follows ? Vec3T<S>(pose.A * value) : value;
 }

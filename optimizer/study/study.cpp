@@ -79,6 +79,30 @@ void check_load_cases(const Study& study, Diagnostics& diag) {
   }
 }
 
+// A modal analysis about the static equilibrium of a load case with harmonic loads, which have no
+// final value, linearizes about the equilibrium of a static analysis of that case listed in the
+// study (which gives their "time"); without one the default equilibrium would evaluate them at
+// t = infinity.
+void check_modal_equilibria(const Study& study, Diagnostics& diag) {
+  for (const AnalysisSpec& a : study.analyses) {
+    if (a.type != AnalysisSpec::Type::kModal || !a.about_static) continue;
+    const bool harmonic =
+        std::any_of(study.model.loads.begin(), study.model.loads.end(), [&](const Load& load) {
+          return load.time.type == TimeFunction::Type::kHarmonic &&
+                 applies_in_case(load, a.load_case);
+        });
+    const bool listed =
+        std::any_of(study.analyses.begin(), study.analyses.end(), [&](const AnalysisSpec& s) {
+          return s.type == AnalysisSpec::Type::kStatic && s.load_case == a.load_case;
+        });
+    if (harmonic && !listed)
+      diag.error(a.where.file, a.where.pointer,
+                 "a modal analysis about the static equilibrium of a scene with harmonic loads "
+                 "(which have no final value) needs a static analysis of its load case with "
+                 "\"time\", whose equilibrium it shares; or \"about\": \"initial\"");
+  }
+}
+
 }  // namespace
 
 std::optional<Study> load_study(const Json& document, const std::string& file,
@@ -164,6 +188,7 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
     if (model) {
       study.model = std::move(*model);
       check_load_cases(study, diag);
+      check_modal_equilibria(study, diag);
     }
 
     std::set<std::string> declared;  // every response name given, read or not

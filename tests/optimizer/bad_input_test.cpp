@@ -541,6 +541,27 @@ TEST_F(BadInput, HarmonicFrequencyBeyondAnyLoad) {
   EXPECT_EQ(r.err.find("frequency"), std::string::npos) << r.err;
 }
 
+// A modal analysis about the static equilibrium (the default with loads) of a scene with harmonic
+// loads and no static analysis of its case: the default equilibrium evaluated them at their
+// undefined final value, and the run failed with the eigensolver's message (an adversarial
+// review, 2026-11-30). Refused, naming the analysis; accepted about the initial configuration or
+// with a static analysis at a time.
+TEST_F(BadInput, ModalAboutTheEquilibriumOfHarmonicLoadsNeedsAStaticAnalysis) {
+  Json s = with("/scene/loads/0/time", {{"type", "harmonic"}, {"frequency", 2.0}});
+  s["analyses"].push_back(Json{{"type", "modal"}});
+  EXPECT_TRUE(HasOnlyError(check(s), "bad.json:/analyses/1:",
+                           "a modal analysis about the static equilibrium of a scene with harmonic "
+                           "loads (which have no final value) needs a static analysis of its load "
+                           "case with \"time\""));
+  s["analyses"][1]["about"] = "initial";
+  Result r = check(s);
+  EXPECT_EQ(r.status, 0) << r.err;
+  s["analyses"][1].erase("about");
+  s["analyses"].push_back(Json{{"type", "static"}, {"time", 0.1}});
+  r = check(s);
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
 TEST_F(BadInput, RampEndNotAfterItsStart) {
   EXPECT_TRUE(HasOnlyError(check(with("/scene/loads/0/time/to", 0.0)),
                            "bad.json:/scene/loads/0/time/to:", "must be greater than \"from\""));

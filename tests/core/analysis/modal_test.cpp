@@ -78,6 +78,42 @@ TEST(Modal, TipBodyWithRotaryInertiaAndOffsetMatchesTheTwoByTwoClosedForm) {
   EXPECT_LT(r.asymmetry, 1e-12);
 }
 
+// About the unloaded initial configuration (load_factor 0, "about": "initial") the loads take no
+// part, harmonic ones too: they have no final value (NaN at the default time, t = infinity), and 0
+// times NaN made the tangent NaN, so that the eigensolver failed (an adversarial review,
+// 2026-11-30). A harmonic force and a harmonic follower torque on the tip: the frequencies of the
+// scene without loads, to the bit.
+TEST(Modal, AboutTheInitialConfigurationHarmonicLoadsTakeNoPart) {
+  const std::string scene = R"(
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"s": {"shape": "rectangle", "width": 0.01, "height": 0.014}},
+    "bodies": [{"name": "tip", "mass": 1.7, "inertia": [2e-3, 3e-3, 4e-3], "position": [0.9, 0, 0]}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [0.9, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "s"}])";
+  const Model plain = testing::scene_from_json("{" + scene + "}");
+  const Model loaded = testing::scene_from_json("{" + scene + R"(,
+    "loads": [{"type": "force", "body": "tip", "value": [0, 0, 200],
+               "time": {"type": "harmonic", "frequency": 1.0}},
+              {"type": "torque", "body": "tip", "value": [0, 50, 0], "follows": true,
+               "time": {"type": "harmonic", "frequency": 3.0, "phase": 0.5}}]})");
+  ModalOptions options;
+  options.modes = 6;
+  options.load_factor = 0.0;
+  ASSERT_TRUE(std::isinf(options.time));
+  Data plain_data(plain), loaded_data(loaded);
+  const ModalResult expected = solve_modal(plain, options, plain_data);
+  const ModalResult r = solve_modal(loaded, options, loaded_data);
+  ASSERT_TRUE(expected.ok) << expected.message;
+  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_EQ(r.modes.size(), expected.modes.size());
+  for (size_t i = 0; i < r.modes.size(); ++i) {
+    std::printf("mode %zu: %.12e Hz, without the loads %.12e Hz\n", i + 1, r.modes[i].frequency_hz,
+                expected.modes[i].frequency_hz);
+    EXPECT_EQ(r.modes[i].frequency_hz, expected.modes[i].frequency_hz) << i;
+  }
+  EXPECT_GT(r.modes[0].frequency_hz, 1.0);
+}
+
 // Two bodies joined by one beam, floating: six rigid-body modes with frequency exactly zero, and
 // the axial mode at sqrt(k (1/m1 + 1/m2)).
 TEST(Modal, FreeFloatingSceneHasSixRigidModesAndCorrectElasticModes) {

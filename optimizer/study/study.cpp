@@ -174,6 +174,7 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
       }
     }
 
+    bool every_analysis_read = false;  // (a static analysis refused is not missing)
     if (const Json* list = r.member("analyses", true)) {
       if (!list->is_array() || list->empty()) {
         r.error("analyses", "expected a non-empty array of analyses");
@@ -182,13 +183,14 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
           if (auto a =
                   read_analysis((*list)[i], root / "analyses" / i, model ? &*model : nullptr, diag))
             study.analyses.push_back(*a);
+        every_analysis_read = study.analyses.size() == list->size();
         name_analyses(study, diag);
       }
     }
     if (model) {
       study.model = std::move(*model);
       check_load_cases(study, diag);
-      check_modal_equilibria(study, diag);
+      if (every_analysis_read) check_modal_equilibria(study, diag);
     }
 
     std::set<std::string> declared;  // every response name given, read or not

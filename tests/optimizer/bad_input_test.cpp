@@ -557,7 +557,12 @@ TEST_F(BadInput, ModalAboutTheEquilibriumOfHarmonicLoadsNeedsAStaticAnalysis) {
   Result r = check(s);
   EXPECT_EQ(r.status, 0) << r.err;
   s["analyses"][1].erase("about");
-  s["analyses"].push_back(Json{{"type", "static"}, {"time", 0.1}});
+  // A static analysis without "time" is refused for itself, the one problem.
+  s["analyses"].push_back(Json{{"type", "static"}});
+  EXPECT_TRUE(
+      HasOnlyError(check(s), "bad.json:/analyses/2/type:",
+                   "the scene has harmonic loads, which have no final value: give \"time\""));
+  s["analyses"][2]["time"] = 0.1;
   r = check(s);
   EXPECT_EQ(r.status, 0) << r.err;
 }

@@ -118,8 +118,15 @@ class AutoIntegrator : public Integrator {
       reason += "; floating and spinning: followed in a frame turning with it (" + number(rate) +
                 " rad/s, the fastest part)";
     if (const std::string band = modal_band_choice(*modal); !band.empty()) reason += "; " + band;
-    for (const std::string& w : modal->warnings) warnings.push_back(w);
-    const bool about_initial = o.about == "initial" || !modal->warnings.empty();
+    // Where the loads push a free body or mechanism along a direction without stiffness no
+    // equilibrium exists, and the initial state is auto's choice, not a fallback: the reason
+    // says so, without the modal method's warning.
+    const InitialLinearization initial = modal_initial_linearization(*modal);
+    for (const std::string& w : modal->warnings)
+      if (!initial.no_equilibrium || w.find(initial.because) == std::string::npos)
+        warnings.push_back(w);
+    const std::string& initial_because = initial.because;
+    const bool about_initial = o.about == "initial" || !initial_because.empty();
     band_hz = modal->band_hz;
     mechanism_ = moves_as_mechanism(model) && !(o.max_frequency_hz > 0.0);
     limit_inertia(*modal);
@@ -127,8 +134,10 @@ class AutoIntegrator : public Integrator {
     modal_ = true;
     linear_solver = "modal";
     record(0.0, "modal",
-           reason + (about_initial ? " (linearized about the initial state)"
-                                   : " (linearized about the equilibrium at t = 0)"));
+           reason + (!initial_because.empty()
+                         ? " (linearized about the initial state: " + initial_because + ")"
+                     : about_initial ? " (linearized about the initial state)"
+                                     : " (linearized about the equilibrium at t = 0)"));
     return true;
   }
 

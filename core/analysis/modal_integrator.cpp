@@ -78,7 +78,8 @@ class ModalExponential : public Integrator {
     ydot13_.resize(model.n_states);
     const double* y = N_VGetArrayPointer(y0);
     std::vector<double> reference(y, y + model.n_states);
-    if (!modal_reference(model, options_, *context_, reference, warnings, error)) return false;
+    if (!modal_reference(model, options_, *context_, reference, warnings, &initial_, error))
+      return false;
     // The linearization: mass and symmetric tangent stiffness at the reference, at rest.
     Data& data = c.data;
     set_state(model, data, reference.data());
@@ -171,6 +172,8 @@ class ModalExponential : public Integrator {
     if (!*count) return {};
     return {MethodPhase{t0_, "modal", band_choice()}};
   }
+
+  const InitialLinearization& initial_linearization() const { return initial_; }
 
   std::string band_choice() const {
     if (band_estimate_ < 0.0) return "";
@@ -804,6 +807,7 @@ class ModalExponential : public Integrator {
   ModeBlock start_ringing_;       // start_ringing()
   double band_hz_ = 0.0;          // the highest frequency integrated [Hz]
   double band_estimate_ = -1.0;   // a chosen band's estimated error (modal_band.hpp); -1: given
+  InitialLinearization initial_;  // why the initial state was linearized about (modal_reference)
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
   Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
   Eigen::VectorXd m0_v_;          // work space of project
@@ -861,6 +865,11 @@ bool modal_damping(const Integrator& integrator, double* largest, double* coupli
   *largest = modal->damping().size() ? modal->damping().maxCoeff() : 0.0;
   *coupling = modal->damping_coupling();
   return true;
+}
+
+InitialLinearization modal_initial_linearization(const Integrator& integrator) {
+  const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
+  return modal ? modal->initial_linearization() : InitialLinearization{};
 }
 
 std::string modal_band_choice(const Integrator& integrator) {

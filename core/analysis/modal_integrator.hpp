@@ -61,6 +61,7 @@
 #include <string>
 
 #include "core/analysis/integrators.hpp"
+#include "core/analysis/modal_reference.hpp"
 
 namespace beamrail {
 
@@ -108,6 +109,9 @@ bool modal_damping(const Integrator& integrator, double* largest, double* coupli
 // How a modal integrator chose its band ("band 812 Hz: 40 of 5,994 modes, ..."); "" when it was
 // given or the integrator is not modal.
 std::string modal_band_choice(const Integrator& integrator);
+// Why a modal integrator linearized about the initial state though "about" did not ask for it
+// (no static equilibrium that can serve: modal_reference).
+InitialLinearization modal_initial_linearization(const Integrator& integrator);
 
 // What a band-limited modal run drops with the kinetic energy of the modes it keeps
 // quasi-static (core/analysis/quasi_static_modes.hpp).

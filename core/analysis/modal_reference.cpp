@@ -26,7 +26,7 @@ std::string rotation_limit_text() {
 
 bool modal_reference(const Model& model, const IntegratorOptions& options, OdeContext& context,
                      std::vector<double>& reference, std::vector<std::string>& warnings,
-                     std::string* error) {
+                     InitialLinearization* initial, std::string* error) {
   if (options.about == "initial") return true;
   if (!options.about.empty() && options.about != "static")
     return refuse(error, "the modal integrator: unknown \"about\": \"" + options.about +
@@ -44,7 +44,13 @@ bool modal_reference(const Model& model, const IntegratorOptions& options, OdeCo
                   "integrator's static solve)");
   }
   std::string why;
-  if (!equilibrium.ok) {
+  if (!equilibrium.ok && equilibrium.no_equilibrium) {
+    // The static solver's own account (the load factor it reached, a carriage that left its
+    // rail on the way) describes its search, not the run.
+    why =
+        "the loads at t = 0 push along a direction without stiffness (a free body or mechanism, "
+        "such as a carriage driven along its rail): no static equilibrium exists";
+  } else if (!equilibrium.ok) {
     why = "no static equilibrium under the loads at t = 0 (" + equilibrium.message + ")";
   } else {
     for (int b = 0; b < model.n_free() && why.empty(); ++b) {
@@ -62,6 +68,8 @@ bool modal_reference(const Model& model, const IntegratorOptions& options, OdeCo
       return refuse(error, "the modal integrator: " + why +
                                "; \"about\": \"initial\" linearizes "
                                "about the initial state");
+    initial->because = why;
+    initial->no_equilibrium = !equilibrium.ok && equilibrium.no_equilibrium;
     warnings.push_back("the modal integrator linearized about the initial state: " + why +
                        (equilibrium.ok ? " (the run stops if a body turns more than " +
                                              rotation_limit_text() + " from there)"

@@ -12,13 +12,21 @@
 
 namespace beamrail {
 
+// Why the modal integrator linearized about the initial state though "about" did not ask for it.
+struct InitialLinearization {
+  std::string because;          // "" when it did not
+  bool no_equilibrium = false;  // the loads push a free body or mechanism along a direction
+                                // without stiffness (a carriage driven along its rail): no
+                                // equilibrium exists, and the initial state is the one to take
+};
+
 // The state linearized about (options.about), written over `reference` (which holds the initial
 // state). False (with *error) when "static" was asked for and no equilibrium was found, or the
-// time budget ran out; an equilibrium that cannot serve without "about" adds a warning and keeps
-// the initial state.
+// time budget ran out. Without "about", an equilibrium that cannot serve keeps the initial state,
+// says why in *initial and adds a warning.
 bool modal_reference(const Model& model, const IntegratorOptions& options, OdeContext& context,
                      std::vector<double>& reference, std::vector<std::string>& warnings,
-                     std::string* error);
+                     InitialLinearization* initial, std::string* error);
 
 // The modal method's rotation limit as messages give it ("1 rad").
 std::string rotation_limit_text();

@@ -177,6 +177,7 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
       newton.restore(saved);
       increment *= 0.5;
       if (newton.final || increment < min_increment) {
+        result.no_equilibrium = newton.pushes_free;
         result.message = newton.failure + format(" (at load factor %.6g, ", factor) +
                          std::to_string(result.load_steps) +
                          (result.load_steps == 1 ? " load step)" : " load steps)");

@@ -85,6 +85,9 @@ struct StaticResult {
   int singular_directions = 0;   // tangent directions with no stiffness (solved minimum-norm)
   int negative_directions = 0;   // of the tangent at the equilibrium (> 0: unstable, not ok)
   int flutter_pairs = 0;  // growing vibration pairs under non-conservative loads (> 0: not ok)
+  // Not ok because the loads push a free body or mechanism along a direction without stiffness
+  // (a carriage pushed along its rail): no equilibrium exists, whatever the load steps.
+  bool no_equilibrium = false;
   double wall_seconds = 0.0;
   std::vector<std::string> warnings;
   // Arc-length control: the path from the unloaded start (the last point the full loads, when

@@ -277,8 +277,9 @@ struct Newton {
   double floor = 0.0;       // rounding floor at the last tangent
   double correction = 0.0;  // last correction / displacement
   std::string failure;
-  bool final = false;      // no smaller load step can help (no equilibrium, precision, budget)
-  int no_equilibrium = 0;  // load steps in a row that found no equilibrium
+  bool final = false;        // no smaller load step can help (no equilibrium, precision, budget)
+  int no_equilibrium = 0;    // load steps in a row that found no equilibrium
+  bool pushes_free = false;  // the last failure: the loads push a free body, mechanism or carriage
 
   struct Saved {
     std::vector<Pose<double>> pose;
@@ -297,9 +298,10 @@ struct Newton {
     return scaled_norm(wrench_vector(model, data), length);
   }
 
-  bool fail(std::string why, bool no_smaller_step) {
+  bool fail(std::string why, bool no_smaller_step, bool pushed_free = false) {
     failure = std::move(why);
     final = no_smaller_step;
+    pushes_free = pushed_free;
     return false;
   }
 
@@ -393,7 +395,7 @@ struct Newton {
         return fail(
             "the loads push along a direction without stiffness (a free mechanism, such as a "
             "carriage pushed along its rails): there is no equilibrium",
-            no_equilibrium > kNoEquilibriumRetries);
+            no_equilibrium > kNoEquilibriumRetries, true);
       }
       const Eigen::VectorXd x = displacement(model, data);
       floor = solver.rounding_floor(x, length);
@@ -425,7 +427,8 @@ struct Newton {
         restore(saved);
         return fail("Newton steps lead to non-finite forces", false);
       }
-      if (std::string away = runaway_carriage(carriages); !away.empty()) return fail(away, false);
+      if (std::string away = runaway_carriage(carriages); !away.empty())
+        return fail(away, false, true);
       if (std::string turned = element_turned_beyond(model, data, kIterateRotationLimit);
           !turned.empty())
         return fail(turned + " in a Newton iterate", false);

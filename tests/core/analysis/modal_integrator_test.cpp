@@ -229,8 +229,10 @@ TEST(ModalIntegrator, LinearizesAboutTheLoadedEquilibrium) {
 }
 
 // A free body pushed by a constant force has no equilibrium: asked for one, the run fails saying
-// so; by default it linearizes about the initial state with a warning, and the motion is the
-// closed form x = F t^2 / 2m (the rigid modes have lambda = 0: the force is integrated exactly).
+// so; by default it linearizes about the initial state with a warning that says why in the run's
+// terms (not the static search's: the load factor it reached), and the motion is the closed form
+// x = F t^2 / 2m (the rigid modes have lambda = 0: the force is integrated exactly). auto takes
+// the initial state as its choice: the reason says why, and no warning.
 TEST(ModalIntegrator, FallsBackToTheInitialStateWithoutAnEquilibrium) {
   const Model model = scene_from_json(R"({
     "bodies": [{"name": "puck", "position": [0, 0, 0], "mass": 2.0, "inertia": [0.1, 0.1, 0.1]}],
@@ -240,18 +242,36 @@ TEST(ModalIntegrator, FallsBackToTheInitialStateWithoutAnEquilibrium) {
   o.integrator.about = "static";
   const TransientRun strict = simulate(model, o);
   EXPECT_FALSE(strict.result.ok);
-  EXPECT_NE(strict.result.message.find("no static equilibrium under the loads at t = 0"),
+  EXPECT_NE(strict.result.message.find("push along a direction without stiffness (a free body "
+                                       "or mechanism, such as a carriage driven along its rail): "
+                                       "no static equilibrium exists"),
             std::string::npos)
       << strict.result.message;
   o.integrator.about = "";
   const TransientRun run = simulate(model, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   ASSERT_EQ(run.result.warnings.size(), 1u);
-  EXPECT_NE(run.result.warnings[0].find("linearized about the initial state"), std::string::npos)
+  const std::string why =
+      "linearized about the initial state: the loads at t = 0 push along a direction without "
+      "stiffness";
+  EXPECT_NE(run.result.warnings[0].find(why), std::string::npos) << run.result.warnings[0];
+  EXPECT_EQ(run.result.warnings[0].find("load factor"), std::string::npos)
       << run.result.warnings[0];
   const int b = body_index(model, "puck");
   ASSERT_EQ(run.samples.size(), 11u);
   for (const auto& s : run.samples)
+    EXPECT_NEAR(s.c[b].x(), 0.75 * s.sample.t * s.sample.t, 1e-14) << s.sample.t;
+
+  o.integrator.method = IntegratorMethod::kAuto;
+  const TransientRun chosen = simulate(model, o);
+  ASSERT_TRUE(chosen.result.ok) << chosen.result.message;
+  EXPECT_TRUE(chosen.result.warnings.empty()) << chosen.result.warnings[0];
+  ASSERT_FALSE(chosen.result.phases.empty());
+  EXPECT_EQ(chosen.result.phases[0].method, "modal");
+  EXPECT_NE(chosen.result.phases[0].reason.find(why), std::string::npos)
+      << chosen.result.phases[0].reason;
+  ASSERT_EQ(chosen.samples.size(), 11u);
+  for (const auto& s : chosen.samples)
     EXPECT_NEAR(s.c[b].x(), 0.75 * s.sample.t * s.sample.t, 1e-14) << s.sample.t;
 }
 

@@ -160,6 +160,7 @@ TEST(RailStatic, StaticSolveReportsOkOnlyWhenTheLoadsAreBalanced) {
     }
     EXPECT_FALSE(c.s.result.ok);
     EXPECT_NE(c.s.result.message.find("no equilibrium"), std::string::npos) << c.s.result.message;
+    EXPECT_TRUE(c.s.result.no_equilibrium) << c.s.result.message;
   }
 }
 

@@ -143,6 +143,7 @@ TEST(StaticExtremes, LoadBeyondDoublePrecisionFails) {
   EXPECT_FALSE(r.result.ok);
   EXPECT_NE(r.result.message.find("beam \"arm\""), std::string::npos) << r.result.message;
   EXPECT_EQ(r.result.message.find("mechanism"), std::string::npos) << r.result.message;
+  EXPECT_FALSE(r.result.no_equilibrium);  // what the modal method's reason would quote
 }
 
 // A shaft twisted by 7.04 rad: split into 40 segments (0.18 rad each) the tip reports the whole
@@ -171,6 +172,7 @@ TEST(StaticExtremes, TwistBeyondPiIsReportedWholeOrRefused) {
       EXPECT_NE(r.result.message.find("beam \"arm\" turned"), std::string::npos);
       // A clamped shaft is no mechanism: the message must not say so (it once did).
       EXPECT_EQ(r.result.message.find("mechanism"), std::string::npos) << r.result.message;
+      EXPECT_FALSE(r.result.no_equilibrium);
     }
   }
 }

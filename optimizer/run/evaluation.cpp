@@ -3,33 +3,21 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <map>
 #include <memory>
 
-#include "core/analysis/modal_step_bounds.hpp"
 #include "core/analysis/stop_request.hpp"
-#include "core/model/forces.hpp"
 #include "optimizer/run/expressions.hpp"
 #include "optimizer/run/number_text.hpp"
 #include "optimizer/run/responses.hpp"
 #include "optimizer/run/trajectory.hpp"
+#include "optimizer/run/transient_checks.hpp"
 
 namespace beamrail {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// How far past rtol an energy drift or a verification may go before the run warns: the
-// tolerance proportionality auto keeps on its tested scenes is within 10 rtol (README).
-constexpr double kDriftTolerance = 10.0;
-
-std::string two_digits(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, x >= 99.5 ? "%.0f" : "%.2g", x);
-  return text;
-}
-
 AnalysisFault analysis_fault = nullptr;  // set_analysis_fault
 
 class Runner {
@@ -368,9 +356,9 @@ class Runner {
     }
     if (!result.ok)
       for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
-    if (report.ok && !(report.max_frequency_hz > 0.0) && !floored(data))
-      warn_of_energy_drift(spec, model, options, report.energy_max_change, energy,
-                           result.stats.steps);
+    if (report.ok && !(report.max_frequency_hz > 0.0) && !rail_floored(data))
+      add_warnings({energy_drift_warning(spec, model, options, report.energy_max_change, energy,
+                                         result.stats.steps)});
     if (verification.empty()) verification = verified_after_the_run(spec, options, result);
     if (report.ok && !verification.empty()) {
       report.verification = rerun_tighter(model, options, trajectory, result.stats);
@@ -380,147 +368,15 @@ class Runner {
         report.interrupted = true;
         report.message = "interrupted in the verification rerun";
       }
-      if (!report.interrupted) warn_of_verification(spec, options, *report.verification);
+      if (!report.interrupted)
+        add_warnings({verification_warning(spec, options, *report.verification)});
     }
-  }
-
-  // The largest kinetic + elastic energy of a run's rows (the energy in play) and the largest sum
-  // of the magnitudes of its three terms (what rounds) [J].
-  struct EnergyScales {
-    double moving = 0.0, terms = 0.0;
-  };
-
-  // Whether a rail reached its min_length in the run (its law has a kink there, at which the
-  // energy jumps by more than the steps' error; the run says so in its own warning).
-  static bool floored(const Data& data) {
-    return std::any_of(data.rail_floored_ever.begin(), data.rail_floored_ever.end(),
-                       [](char c) { return c != 0; });
-  }
-
-  // A scene that keeps its energy (conserves_energy) whose run changed it by more than
-  // kDriftTolerance rtol of the energy in play: the run warns, as its error may then be far above
-  // rtol. Adaptive runs of the whole model only (a fixed step's error is not rtol's; a band drops
-  // the energy of the modes above it by design), and above the rounding of the energy's terms
-  // over the steps (reference runs at rtol 1e-11 and below drift by rounding: a pendulum of 2.25
-  // million steps by 1.5e-11 J of 3.8 J, a body 10 km above the origin by a few ulp of its
-  // gravity energy). Measured (README "Energy drift and verify warn"): free elastic pairs
-  // spinning, auto at rtol 1e-4 and 1e-6, drifts of 12 to 208 rtol where the motion was 12 to 537
-  // rtol off; the tumbling pair within 7 rtol where its centres are within 2.
-  void warn_of_energy_drift(const AnalysisSpec& spec, const Model& model,
-                            const TransientOptions& options, double drift,
-                            const EnergyScales& energy, long steps) {
-    const double rtol = options.integrator.rtol;
-    if (options.integrator.fixed_step > 0.0 || !(energy.moving > 0.0) || !conserves_energy(model))
-      return;
-    const double rounding = std::numeric_limits<double>::epsilon() * energy.terms *
-                            static_cast<double>(std::max(1L, steps));
-    const double ratio = drift / energy.moving;
-    if (!(ratio > kDriftTolerance * rtol) || !(drift > rounding)) return;
-    add_warnings({"transient \"" + spec.name + "\": the energy changed by " + two_digits(ratio) +
-                  " of the largest kinetic + elastic energy (" + two_digits(ratio / rtol) +
-                  " rtol) in a scene that keeps it (no loads, no damping): the motion may be "
-                  "off by more than rtol; \"verify\": true measures it (a mechanism is verified by "
-                  "default)"});
-  }
-
-  // Why the transient is verified (summary.json verification.reason), "" when it is not: asked
-  // ("verify": true), or by default ("auto") where its scene moves as a mechanism (a body not held
-  // by beams and fixed joints to the ground, and not part of a floating part: a pendulum on a
-  // joint, a carriage on a rail) and its steps are adaptive. There every method's error control
-  // was found silently off, by up to 1e4 times rtol, where no other check saw it (README
-  // "Mechanisms verify themselves"); a rerun at rtol / 10 measured each such run's error and
-  // warned of every one beyond 10 times its tolerance. It costs the rerun: 1.8 times the run's
-  // time at the median of 63 review runs, at most 2.5 times in 45 of them, 65 times at worst.
-  static std::string verification_reason(const AnalysisSpec& spec, const Model& model,
-                                         const TransientOptions& options) {
-    switch (spec.verify) {
-      case AnalysisSpec::Verify::kAlways:
-        return "asked (\"verify\": true)";
-      case AnalysisSpec::Verify::kNever:
-        return "";
-      case AnalysisSpec::Verify::kAuto:
-        break;
-    }
-    if (options.integrator.fixed_step > 0.0 || !moves_as_mechanism(model)) return "";
-    return "\"verify\": \"auto\", the default: bodies move as a mechanism (not held by beams "
-           "and fixed joints to the ground), where error control was found far off without a "
-           "sign; \"verify\": false skips the rerun";
-  }
-
-  // Whether a transient that verification_reason does not verify may be verified after its run
-  // (verified_after_the_run): "verify": "auto" on an adaptive auto run.
-  static bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& options) {
-    return spec.verify == AnalysisSpec::Verify::kAuto && options.integrator.fixed_step <= 0.0 &&
-           options.integrator.method == IntegratorMethod::kAuto;
-  }
-
-  // Why a transient is verified after its run, "" when it is not: by default ("auto") an auto run
-  // that relinearized as a body turned its limit. Its motion is then not a small one about a
-  // configuration, where the modal method's error estimates were measured to hold; along large
-  // motions the error can grow far past rtol with no other sign: an L-frame (a 1 m steel
-  // cantilever in 5 segments, a 0.6 m leg from its 1 kg tip to a 2 kg foot, the tip started at
-  // 2.2 m/s; an adversarial review, 2026-11-30) came out 10 / 1,150 rtol off at rtol 1e-3 / 1e-5
-  // against Verner at rtol 1e-11, warned only of its model (the beams' axial forces), and its
-  // reruns measured 13 / 1,022 (README "Large motions verify themselves"). Not where auto only
-  // handed over to another method after a failed modal phase: a 100-segment cantilever whose band
-  // failed at 3 us ran dirk, and its rerun at rtol 1e-7 was itself 21 times farther off than the
-  // run (a false alarm).
-  static std::string verified_after_the_run(const AnalysisSpec& spec,
-                                            const TransientOptions& options,
-                                            const TransientResult& result) {
-    if (!may_verify_after_the_run(spec, options) ||
-        std::none_of(result.phases.begin(), result.phases.end(),
-                     [](const MethodPhase& p) { return p.relinearized; }))
-      return "";
-    return "\"verify\": \"auto\", the default: the run relinearized as bodies turned (" +
-           std::to_string(result.phase_count) +
-           " phases): a large motion, where error control was found far off without a sign; "
-           "\"verify\": false skips the rerun";
   }
 
   // The output rows of a transient, its first state included.
   static long output_rows(const TransientOptions& options) {
     return 1 +
            std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
-  }
-
-  // A verification rerun farther from the run than kDriftTolerance times its tolerance: in the
-  // centres rtol x + atol, x the rerun's largest motion [m]; in the orientations rtol max(x, 1 rad)
-  // + atol radians, x the largest angle a body of the rerun turned along its samples (every
-  // method weights a rotation absolutely, about rtol radians per step: a carriage tilting 3.7e-4
-  // rad on a rail was 4.8e-8 rad off at rtol 1e-6, 129 rtol of its turn; a spin's phase error
-  // grows with the angle turned: the tumbling pair's 27 rad, about 3 rtol per radian). The
-  // orientations only where successive samples are within kLongestSampledTurn (else a sample may
-  // have skipped a turn and the angle turned is not known); the centres still count there.
-  void warn_of_verification(const AnalysisSpec& spec, const TransientOptions& options,
-                            const Verification& v) {
-    const double rtol = options.integrator.rtol, atol = options.integrator.atol;
-    if (!v.ok) {
-      // A rerun that did not finish measured nothing (the run at rtol 1e-8 of a carriage with a
-      // pendulum under a harmonic force: its rerun spent max_steps in 50 s, the run took 10 s).
-      add_warnings({"transient \"" + spec.name + "\": the verification rerun failed (" + v.message +
-                    "): the run's error is not measured"});
-      return;
-    }
-    if (options.integrator.fixed_step > 0.0) return;
-    std::string what;
-    // Each figure also in multiples of the tolerance, which decides: where atol dominates it, the
-    // rtol figure alone reads far larger (a bob swinging 78 um: 1.8e4 rtol, 140 tolerances).
-    const double centres = v.error * v.motion / (rtol * v.motion + atol);
-    if (v.motion > 0.0 && centres > kDriftTolerance)
-      what = "the body centres by " + two_digits(v.error) + " of their motion (" +
-             two_digits(centres) + " times their tolerance rtol x + atol; " +
-             two_digits(v.error / rtol) + " rtol)";
-    const double angle = v.rotation_error * v.turn;  // [rad]
-    const double orientations = angle / (rtol * std::max(v.turned, 1.0) + atol);
-    if (v.turned > 0.0 && orientations > kDriftTolerance)
-      what += (what.empty() ? "" : " and ") + std::string("the orientations by ") +
-              two_digits(angle) + " rad (" + two_digits(orientations) + " times their tolerance; " +
-              two_digits(angle / v.turned / rtol) + " rtol of the " + two_digits(v.turned) +
-              " rad turned)";
-    if (what.empty()) return;
-    add_warnings({"transient \"" + spec.name + "\": the verification rerun at rtol / 10 moved " +
-                  what + ": the run is not within its tolerance; run it at a smaller rtol"});
   }
 
   // The elastic modes of a modal result and the mode each frequency response read (chosen: per
@@ -657,7 +513,8 @@ class Runner {
 
   void add_warnings(const std::vector<std::string>& warnings) {
     for (const std::string& w : warnings)
-      if (std::find(ev_.warnings.begin(), ev_.warnings.end(), w) == ev_.warnings.end())
+      if (!w.empty() &&
+          std::find(ev_.warnings.begin(), ev_.warnings.end(), w) == ev_.warnings.end())
         ev_.warnings.push_back(w);
   }
 

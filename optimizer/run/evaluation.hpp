@@ -17,29 +17,11 @@
 #include "optimizer/run/responses.hpp"
 #include "optimizer/run/result_tables.hpp"
 #include "optimizer/run/status.hpp"
+#include "optimizer/run/transient_checks.hpp"
 #include "optimizer/run/transient_sink.hpp"
 #include "optimizer/study/study.hpp"
 
 namespace beamrail {
-
-// A transient rerun at tolerances ten times tighter: the error the run achieved beside its cost.
-struct Verification {
-  bool ok = false;
-  std::string message;
-  double rtol = 0.0, atol = 0.0;  // of the tighter run
-  double fixed_step = 0.0;        // of the tighter run (half the run's); 0: adaptive
-  // Where the first rerun repeated the run state for state: the second rerun's longest step
-  // (half the run's mean step) [s]; 0: none
-  double max_step = 0.0;
-  double error = 0.0;           // largest body-centre distance between the runs / largest motion
-  double rotation_error = 0.0;  // largest angle between the runs' orientations / largest turn
-  // The tighter run's largest centre motion [m], largest turn [rad, at most pi] and largest turn
-  // along its samples [rad; NaN when its samples may have skipped a turn]: what the errors are
-  // measured against.
-  double motion = 0.0, turn = 0.0, turned = 0.0;
-  SolverStats stats;   // of the tighter run
-  std::string reason;  // why the run was verified: asked, or "verify": "auto"
-};
 
 struct AnalysisReport {
   std::string type;                 // "transient", "static", "modal", "buckling"

@@ -35,7 +35,7 @@ struct AnalysisSpec {
   bool about_static = false;  // modal: linearize about the static equilibrium (else: initial)
   // transient: rerun at tolerances ten times tighter and report the error. kAuto (the study
   // file's default, "auto"): where the scene moves as a mechanism and the steps are adaptive
-  // (verification_reason in optimizer/run/evaluation.cpp says why).
+  // (verification_reason in optimizer/run/transient_checks.cpp says why).
   enum class Verify { kAuto, kAlways, kNever };
   Verify verify = Verify::kAuto;
   // transient: start at the static equilibrium of the loads at t = 0 (else: the scene's state)

@@ -1,0 +1,73 @@
+// Whether a transient's result can be trusted: the checks that make a run say so when it may not
+// be (optimizer/run/evaluation.cpp runs them after each transient): the energy drift of a scene
+// that keeps its energy, and the verification rerun (when a run is verified and what its rerun
+// found). Each warning is "" where there is nothing to say.
+#pragma once
+
+#include <string>
+
+#include "core/analysis/transient.hpp"
+#include "core/model/data.hpp"
+#include "core/model/model.hpp"
+#include "optimizer/study/study.hpp"
+
+namespace beamrail {
+
+// A transient rerun at tolerances ten times tighter: the error the run achieved beside its cost.
+struct Verification {
+  bool ok = false;
+  std::string message;
+  double rtol = 0.0, atol = 0.0;  // of the tighter run
+  double fixed_step = 0.0;        // of the tighter run (half the run's); 0: adaptive
+  // Where the first rerun repeated the run state for state: the second rerun's longest step
+  // (half the run's mean step) [s]; 0: none
+  double max_step = 0.0;
+  double error = 0.0;           // largest body-centre distance between the runs / largest motion
+  double rotation_error = 0.0;  // largest angle between the runs' orientations / largest turn
+  // The tighter run's largest centre motion [m], largest turn [rad, at most pi] and largest turn
+  // along its samples [rad; NaN when its samples may have skipped a turn]: what the errors are
+  // measured against.
+  double motion = 0.0, turn = 0.0, turned = 0.0;
+  SolverStats stats;   // of the tighter run
+  std::string reason;  // why the run was verified: asked, or "verify": "auto"
+};
+
+// How far past rtol an energy drift or a verification may go before the run warns: the
+// tolerance proportionality auto keeps on its tested scenes is within 10 rtol (README).
+inline constexpr double kDriftTolerance = 10.0;
+
+// The largest kinetic + elastic energy of a run's rows (the energy in play) and the largest sum
+// of the magnitudes of its three terms (what rounds) [J].
+struct EnergyScales {
+  double moving = 0.0, terms = 0.0;
+};
+
+// Whether a rail reached its min_length in the run (the energy jumps at its law's kink: no drift
+// check).
+bool rail_floored(const Data& data);
+
+// The warning of a run of a scene that keeps its energy whose energy drifted by more than
+// kDriftTolerance rtol of the energy in play (drift and energy: the run's largest change and
+// scales; steps: its steps, for the rounding floor).
+std::string energy_drift_warning(const AnalysisSpec& spec, const Model& model,
+                                 const TransientOptions& options, double drift,
+                                 const EnergyScales& energy, long steps);
+
+// Why a transient is verified before its run (summary.json verification.reason), "" when it is
+// not: asked, or by default where its scene moves as a mechanism.
+std::string verification_reason(const AnalysisSpec& spec, const Model& model,
+                                const TransientOptions& options);
+
+// Whether a transient that verification_reason does not verify may be verified after its run.
+bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& options);
+
+// Why a transient is verified after its run ("" when it is not): an auto run that relinearized.
+std::string verified_after_the_run(const AnalysisSpec& spec, const TransientOptions& options,
+                                   const TransientResult& result);
+
+// The warning of a verification rerun farther from the run than kDriftTolerance times its
+// tolerance, or that failed.
+std::string verification_warning(const AnalysisSpec& spec, const TransientOptions& options,
+                                 const Verification& v);
+
+}  // namespace beamrail

@@ -3,9 +3,10 @@
 // farther than 10 rtol from the run warns. The scene is a free pair of bodies on a stiff steel
 // rod, spinning (found by an adversarial review: auto at rtol 1e-4 was 30 rtol off in 3 s, status
 // ok, without a warning; auto now follows it in a turning frame and is within rtol, while dirk
-// at rtol 1e-4 with a loose atol of 1e-4 stands for a run that is not: 19 rtol off; with atol
-// 3e-8 dirk stood for it until 2026-11-29, 127 rtol off through the stage derivatives it
-// deduced, and is 1.1 rtol off since, integrators.cpp); the independent
+// at rtol 1e-3 with atol 1e-3 stands for a run that is not: 13 rtol off. dirk at rtol 1e-4 stood
+// for it until 2026-11-30: with atol 3e-8 127 rtol off through the stage derivatives it deduced
+// (1.1 rtol since 2026-11-29), with atol 1e-4 19 rtol off through interpolated outputs (1.9 rtol
+// since its steps end on them, integrators.cpp); the independent
 // reference is the explicit Verner 8(7) table at rtol 1e-11, the errors the largest body-centre
 // distance over the largest motion.
 #include <gtest/gtest.h>
@@ -121,7 +122,7 @@ class EnergyDrift : public testing::StudyRuns {
 TEST_F(EnergyDrift, ASpinningPairWarnsWhereItsEnergyAndMotionAreOffAndNotWhereTheyAreNot) {
   double off_error = 0.0, loose_error = 0.0, tight_error = 0.0;
   const Json off =
-      run_pair("off", {{"method", "dirk"}, {"rtol", 1e-4}, {"atol", 1e-4}}, false, &off_error);
+      run_pair("off", {{"method", "dirk"}, {"rtol", 1e-3}, {"atol", 1e-3}}, false, &off_error);
   const Json loose =
       run_pair("loose", {{"method", "auto"}, {"rtol", 1e-4}, {"atol", 3e-8}}, false, &loose_error);
   const Json tight =
@@ -129,19 +130,23 @@ TEST_F(EnergyDrift, ASpinningPairWarnsWhereItsEnergyAndMotionAreOffAndNotWhereTh
   const std::vector<std::string> warned = warnings_of(off);
   const double drift = figure_before(warned, "the energy changed by", " rtol)");
   std::printf(
-      "dirk, rtol 1e-4: motion %.2e (%.0f rtol), energy drift %.0f rtol; auto, rtol 1e-4: %.2e "
+      "dirk, rtol 1e-3: motion %.2e (%.0f rtol), energy drift %.0f rtol; auto, rtol 1e-4: %.2e "
       "(%.3f rtol); rtol 1e-8: %.2e (%.3f rtol)\n",
-      off_error, off_error / 1e-4, drift, loose_error, loose_error / 1e-4, tight_error,
+      off_error, off_error / 1e-3, drift, loose_error, loose_error / 1e-4, tight_error,
       tight_error / 1e-8);
-  // The warning is right: the motion is more than 10 rtol off (19 measured) ...
+  // The warning is right: the motion is more than 10 rtol off (13 measured) ...
   EXPECT_EQ(off["status"], "ok");
-  EXPECT_GT(off_error, 10 * 1e-4);
+  EXPECT_GT(off_error, 10 * 1e-3);
   EXPECT_TRUE(has(warned, "transient \"spin\": the energy changed by")) << off.dump(2);
   EXPECT_GT(drift, 10.0);
-  // ... and the drift it quotes is the summary's, over the largest kinetic + elastic energy
-  // (here the initial energy, all kinetic, stays the largest within the drift).
-  const double relative = off["analyses"][0]["energy_max_relative_change"].get<double>();
-  EXPECT_NEAR(drift, relative / 1e-4, 0.02 * relative / 1e-4);
+  // ... and the drift it quotes is the summary's, over the largest kinetic + elastic energy: the
+  // run gains energy (7.0 % at most, 6.5 % at the end), so the largest is the initial energy,
+  // all kinetic, times 1 + the summary's change.
+  const Json& a = off["analyses"][0];
+  const double relative = a["energy_max_relative_change"].get<double>();
+  EXPECT_GT(a["energy_final"].get<double>(), a["energy_initial"].get<double>());
+  const double of_largest = relative / (1.0 + relative) / 1e-3;
+  EXPECT_NEAR(drift, of_largest, 0.02 * of_largest);
   // auto at rtol 1e-4 and 1e-8 is within its tolerance and says nothing.
   EXPECT_LT(loose_error, 10 * 1e-4);
   EXPECT_TRUE(warnings_of(loose).empty()) << loose.dump(2);
@@ -150,11 +155,11 @@ TEST_F(EnergyDrift, ASpinningPairWarnsWhereItsEnergyAndMotionAreOffAndNotWhereTh
 }
 
 TEST_F(EnergyDrift, AVerificationFartherThanTenRtolWarnsWithItsFigure) {
-  // Over 6 s the same run drifts to 100 rtol of the motion, beyond 10 times rtol + atol / motion
-  // (its tolerance, 0.3 m of motion), which the 3 s run is not.
+  // Over 6 s the same run drifts to 55 rtol of the motion, beyond 10 times rtol + atol / motion
+  // (its tolerance, 0.3 m of motion: 43 rtol), which the 3 s run (13 rtol) is not.
   double error = 0.0;
   const Json s =
-      run_pair("verified", {{"method", "dirk"}, {"rtol", 1e-4}, {"atol", 1e-4}}, true, &error, 6.0);
+      run_pair("verified", {{"method", "dirk"}, {"rtol", 1e-3}, {"atol", 1e-3}}, true, &error, 6.0);
   const Json& v = s["analyses"][0]["verification"];
   const std::vector<std::string> warned = warnings_of(s);
   const double quoted = figure_before(warned,
@@ -164,7 +169,7 @@ TEST_F(EnergyDrift, AVerificationFartherThanTenRtolWarnsWithItsFigure) {
   std::printf("verification %.3e, quoted %.0f rtol; against the reference %.3e\n",
               v["error"].get<double>(), quoted, error);
   ASSERT_TRUE(has(warned, "the run is not within its tolerance")) << s.dump(2);
-  EXPECT_NEAR(quoted, v["error"].get<double>() / 1e-4, 0.02 * quoted);
+  EXPECT_NEAR(quoted, v["error"].get<double>() / 1e-3, 0.02 * quoted);
   // The rerun's distance is an estimate of the run's own error (within a factor of 2 here).
   EXPECT_GT(v["error"].get<double>(), 0.5 * error);
   EXPECT_LT(v["error"].get<double>(), 2.0 * error);
@@ -190,10 +195,11 @@ TEST_F(EnergyDrift, ScenesThatDoNotKeepTheirEnergyDoNotWarnOfIt) {
 }
 
 // A cantilever in 20 segments under gravity started at its static equilibrium and nudged by a
-// 1e-8 N step moves by 2e-12 m, where rounding is a part of it: its rerun is 0.012 of that away
-// (1.2e4 rtol). A review found verify warned of such a run (then moved by rounding only, 3.6e-12
-// m, through dirk's deduced stage derivatives) as 1.3 million rtol. Within atol, it is no sign of
-// error: no warning. The energy does not warn either.
+// 1e-8 N step moves by 2e-12 m, where rounding is a part of it: its rerun is 3.2e-4 of that away
+// (315 rtol; 0.012 while dirk's outputs were interpolated, until 2026-11-30). A review found verify
+// warned of such a run (then moved by rounding only, 3.6e-12 m, through dirk's deduced stage
+// derivatives) as 1.3 million rtol. Within atol, it is no sign of error: no warning. The energy
+// does not warn either.
 TEST_F(EnergyDrift, MotionWithinAtolDoesNotWarn) {
   const Json s = Json::parse(R"({
     "name": "at_rest",
@@ -215,9 +221,9 @@ TEST_F(EnergyDrift, MotionWithinAtolDoesNotWarn) {
   const Json summary = load_json(dir_ / "at_rest/summary.json");
   const Json& v = summary["analyses"][0]["verification"];
   std::printf("verification: %s\n", v.dump().c_str());
-  // The rerun is far beyond 10 rtol (1e-6) of the motion ...
+  // The rerun is far beyond 10 rtol (1e-5) of the motion ...
   ASSERT_TRUE(v["error"].is_number()) << summary.dump(2);
-  EXPECT_GT(v["error"].get<double>(), 1e-3);
+  EXPECT_GT(v["error"].get<double>(), 1e-4);
   // ... and well within atol: no warning of it, nor of the energy.
   EXPECT_FALSE(has(warnings_of(summary), "the verification rerun")) << summary.dump(2);
   EXPECT_FALSE(has(warnings_of(summary), "the energy changed by")) << summary.dump(2);

@@ -184,20 +184,23 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionRunsPastTheirBudgetAreTimeoutRows) {
 }
 
 // "verify" measures a run against the same run at tolerances ten times tighter; the estimate must
-// agree with the error measured against a tight reference by the work-precision study.
+// agree with the error measured against a tight reference by the work-precision study. The
+// explicit default table at rtol 1e-4: the reference's own error is some 1.7e-9 (Verner's runs
+// stay there from rtol 1e-6 down), and dirk, whose steps end on the outputs since 2026-11-30, is
+// within 1e-8 at every rtol from 1e-4 down; bdf's rerun at rtol 1e-7 took fewer steps than its
+// run at 1e-6 (978 against 1,172).
 TEST_F(SpeedAccuracyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightReference) {
-  const auto [measured, summary] = measure_and_verify(Json{{"method", "dirk"}}, 1e-6);
+  const auto [measured, summary] = measure_and_verify(Json{{"method", "erk"}}, 1e-4);
   const Json& v = summary["analyses"][0]["verification"];
   ASSERT_TRUE(v.is_object()) << summary.dump(2);
   EXPECT_EQ(v["status"], "ok");
-  EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-7);
-  EXPECT_DOUBLE_EQ(v["atol"].get<double>(), 1e-11);
+  EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-5);
+  EXPECT_DOUBLE_EQ(v["atol"].get<double>(), 1e-9);
   EXPECT_FALSE(v.contains("fixed_step"));
   EXPECT_GT(v["steps"].get<long>(), summary["analyses"][0]["steps"].get<long>());
   const double estimate = v["error"];
-  std::printf(
-      "dirk rtol 1e-6: error %.4g against rtol 1e-11, %.4g against rtol 1e-7 (ratio %.3f)\n",
-      measured, estimate, estimate / measured);
+  std::printf("erk rtol 1e-4: error %.4g against rtol 1e-11, %.4g against rtol 1e-5 (ratio %.3f)\n",
+              measured, estimate, estimate / measured);
   // If the tighter run's own error is at most a third of the run's, the estimate lies within
   // [2/3, 4/3] of the true error.
   EXPECT_GT(estimate / measured, 2.0 / 3.0);
@@ -272,11 +275,13 @@ TEST_F(SpeedAccuracyRuns, VerifyMeasuresARunWrongOnlyInItsRotations) {
 // the rotation errors are the largest angle between each run's and the reference's orientation
 // over the largest turn (here measured again from timeseries.csv of the same runs alone), and the
 // fastest run within the target is judged by them: the loose run, wrong by more than the target
-// in its rotations, is not chosen.
+// in its rotations, is not chosen. The target is 3e-6: with bdf's steps ended on the outputs
+// where they outgrow the spacing (2026-11-30) the pushed disk's loose run is 6.3e-6 off in its
+// rotations, within the former target of 1e-5.
 TEST_F(SpeedAccuracyRuns, WorkPrecisionMeasuresRotationsAndJudgesRunsByThem) {
   Json s = twisted_disk();
   const Json plan = Json::parse(R"({"type": "work_precision", "methods": [{"method": "bdf"}],
-    "rtols": [1e-4, 1e-7], "atol_scale": 1e-4, "target_error": 1e-5,
+    "rtols": [1e-4, 1e-7], "atol_scale": 1e-4, "target_error": 3e-6,
     "reference": {"method": "bdf", "rtol": 1e-11, "atol": 1e-15}})");
   s["study"] = plan;
   ASSERT_NO_FATAL_FAILURE(run_ok(write_study("wp.json", s), "wp"));
@@ -304,8 +309,8 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionMeasuresRotationsAndJudgesRunsByThem) {
     EXPECT_TRUE(std::isnan(std::stod(t.at(r, "error")))) << t.at(r, "error");
     EXPECT_NEAR(tabulated / measured[r], 1.0, 1e-6);
   }
-  EXPECT_GT(measured[0], 1e-5);  // the loose run misses the target in its rotations only
-  EXPECT_LT(measured[1], 1e-5);
+  EXPECT_GT(measured[0], 3e-6);  // the loose run misses the target in its rotations only
+  EXPECT_LT(measured[1], 3e-6);
   const Json summary = load_json(dir_ / "wp" / "summary.json");
   const Json& best = summary["fastest_within_target"];
   ASSERT_TRUE(best.is_object()) << summary.dump(2);
@@ -324,8 +329,8 @@ TEST_F(SpeedAccuracyRuns, WorkPrecisionMeasuresRotationsAndJudgesRunsByThem) {
   ASSERT_EQ(p.rows.size(), 2u);
   std::printf("pushed and twisted, bdf rtol 1e-4: centre error %s, rotation error %s\n",
               p.at(0, "error").c_str(), p.at(0, "rotation_error").c_str());
-  EXPECT_LT(std::stod(p.at(0, "error")), 1e-5);
-  EXPECT_GT(std::stod(p.at(0, "rotation_error")), 1e-5);
+  EXPECT_LT(std::stod(p.at(0, "error")), 3e-6);
+  EXPECT_GT(std::stod(p.at(0, "rotation_error")), 3e-6);
   const Json chosen = load_json(dir_ / "pushed" / "summary.json")["fastest_within_target"];
   ASSERT_TRUE(chosen.is_object());
   EXPECT_EQ(chosen["rtol"], 1e-7);

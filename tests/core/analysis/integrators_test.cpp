@@ -325,6 +325,58 @@ TEST(Integrators, ImplicitRungeKuttaStepsThroughAnOverdampedMode) {
   }
 }
 
+// Where the motion is slow the steps grow far past the output spacing, and the SUNDIALS dense
+// output between them is not error-controlled. The 10 mm point-mass tip on a steel cantilever of
+// its own mass with beam damping 1e-2 s under a step of (0, -1, 0.3) N, 0.2 s, outputs every 1
+// ms, against the modal method at rtol 1e-10: dirk's default table's interpolated outputs came
+// out 3.8 / 18 / 17 rtol of the motion off at rtol 1e-4 / 1e-6 / 1e-8 (19 / 27 / 48 steps),
+// silent; ending its steps on the outputs (integrators.cpp), 4e-9 / 4e-7 / 3e-5 (208 / 210 / 216
+// steps). ESDIRK547 was within 0.5 there, and is within 4.4e-6 now; bdf at rtol 1e-4 / 1e-6 0.67
+// / 1.3, now 1.8e-5 / 0.0029 (and 0.0045 at 1e-8), its steps ended on the outputs where they
+// outgrew the spacing.
+TEST(Integrators, OutputsAreStepsNotInterpolants) {
+  std::string scene = testing::point_mass_tip(0.01, 1.0);
+  const size_t at = scene.find(R"("section": "sq")");
+  ASSERT_NE(at, std::string::npos);
+  scene.insert(at, R"("damping": 0.01, )");
+  const std::string unloaded_z = R"(, 0], "time")";
+  const size_t load = scene.find(unloaded_z);
+  ASSERT_NE(load, std::string::npos);
+  scene.replace(load, unloaded_z.size(), R"(, 0.3], "time")");
+  const std::string massless = R"("G": 8.0769e10})";
+  const size_t steel = scene.find(massless);
+  ASSERT_NE(steel, std::string::npos);
+  scene.replace(steel, massless.size(), R"("G": 8.0769e10, "density": 7850})");
+  const Model model = scene_from_json(scene);
+  const int tip = body_index(model, "tip");
+  TransientOptions tight_modal = options(0.2, 1e-3, 1e-10, 1e-15);
+  tight_modal.integrator.method = IntegratorMethod::kAuto;
+  const TransientRun reference = simulate(model, tight_modal);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  ASSERT_EQ(reference.result.phases.size(), 1u);
+  ASSERT_EQ(reference.result.phases[0].method, "modal");
+  // Each run must end at least one step on each of the 200 outputs.
+  TransientOptions o = options(0.2, 1e-3, 1e-4, 1e-10);
+  o.integrator.method = IntegratorMethod::kDirk;
+  const TransientRun run = simulate(model, o);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  EXPECT_GE(run.result.stats.steps, 200);
+  expect_dirk_within_rtol(model, reference, tip, options(0.2, 1e-3, 1.0, 4e-7), {1e-4, 1e-6, 1e-8},
+                          "damped point-mass tip, off-axis step");
+  for (double rtol : {1e-4, 1e-6, 1e-8}) {
+    TransientOptions m = options(0.2, 1e-3, rtol, 4e-7 * rtol);
+    m.integrator.method = IntegratorMethod::kBdf;
+    const TransientRun r = simulate(model, m);
+    ASSERT_TRUE(r.result.ok) << r.result.message;
+    const double e = motion_error(r, reference, tip) / rtol;
+    std::printf(
+        "damped point-mass tip, off-axis step, bdf, rtol %.0e: %.3g rtol of the motion, "
+        "%ld steps\n",
+        rtol, e, r.result.stats.steps);
+    EXPECT_LT(e, 1.0);
+  }
+}
+
 // A driven hub spins a 10 m beam (the spin-up of studies/spin_up.json, in 10 segments, up to
 // 6 rad/s over 2 s, 3 s): auto runs dirk (a moving support). Its tip against a tight explicit run,
 // in error weights rtol x 10 m: with the stage derivatives deduced 32 / 87 / 3.3 at rtol 1e-4 /

@@ -220,6 +220,17 @@ TEST(Integrators, AnExplicitRunsRowsAtRestStayAtRest) {
 
 // Runs dirk (the default table and ESDIRK547) at each rtol, atol = `base.integrator.atol` x rtol,
 // with `base`'s span and outputs, and expects body `b` within rtol of its motion in `reference`.
+// A reference run of a damped structure at rtol 1e-10, outputs every 1 ms: auto must run it
+// with the modal method (each mode's damping exact).
+void tight_modal_run(const Model& model, double t_end, double atol, TransientRun* run) {
+  TransientOptions o = options(t_end, 1e-3, 1e-10, atol);
+  o.integrator.method = IntegratorMethod::kAuto;
+  *run = simulate(model, o);
+  ASSERT_TRUE(run->result.ok) << run->result.message;
+  ASSERT_EQ(run->result.phases.size(), 1u);
+  ASSERT_EQ(run->result.phases[0].method, "modal");
+}
+
 void expect_dirk_within_rtol(const Model& model, const TransientRun& reference, int b,
                              const TransientOptions& base, std::initializer_list<double> rtols,
                              const char* label) {
@@ -244,7 +255,8 @@ void expect_dirk_within_rtol(const Model& model, const TransientRun& reference, 
 // Newton solution (ARKStepSetDeduceImplicitRhs, taken until 2026-11-29) the default table came
 // out 4.3 / 25 / 52 / 19 rtol of the motion off at rtol 1e-4 / 1e-5 / 1e-6 / 1e-7, silent; the
 // derivatives evaluated, 0.0026 / 0.014 / 0.025 / 0.083 (ESDIRK547 1.1 / 0.70 / 0.85 / 0.18 ->
-// below 0.012).
+// below 0.012). Since the steps end on the outputs (OutputsAreStepsNotInterpolants), 4.5e-6 /
+// 1.5e-5 / 6.4e-5 / 0.040 (ESDIRK547 below 4.2e-4).
 TEST(Integrators, ImplicitRungeKuttaFollowsRtolWhereAStiffModeRings) {
   const Model model = scene_from_json(testing::point_mass_tip(0.01, 1.0));
   const int tip = body_index(model, "tip");
@@ -259,7 +271,8 @@ TEST(Integrators, ImplicitRungeKuttaFollowsRtolWhereAStiffModeRings) {
 // with Verner at rtol 1e-11 to 1.9e-11 of the motion). An evaluated stage derivative carries the
 // Newton iteration's error times the damped stiffness: at ARKODE's Newton coefficient 109 / 120
 // rtol off at rtol 1e-4 / 1e-6 (ESDIRK547 21 / 0.31), silent; at kDampedNewtonCoefficient 0.26 /
-// 0.33 (0.25 / 0.029).
+// 0.33 (0.25 / 0.029), and 2.0e-5 / 8.9e-4 (1.2e-5 / 2.1e-4) since the steps end on the
+// outputs.
 TEST(Integrators, ImplicitRungeKuttaFollowsRtolOnADampedBeam) {
   std::string scene = reference_cantilever(10);
   const size_t at = scene.find(R"("segments": 10)");
@@ -280,26 +293,20 @@ TEST(Integrators, ImplicitRungeKuttaFollowsRtolOnADampedBeam) {
 // repeatedly, also at the smallest step": the default table at 0.020 / 0.013 / 0.0006 s at rtol
 // 1e-4 / 1e-6 / 1e-8); with kDirkMaxErrorTestFailures (integrators.cpp) they run, against the
 // modal method at rtol 1e-10 (each mode's damping exact; bdf at rtol 1e-10 agrees to 3e-9 of the
-// motion) 0.014 / 0.16 / 0.45 of their tolerance (ESDIRK547 0.056 / 0.032 / 0.093).
+// motion) 0.014 / 0.16 / 0.45 of their tolerance (ESDIRK547 0.056 / 0.032 / 0.093); since the
+// steps end on the outputs, 8.5e-5 / 0.0030 / 0.036 (4.4e-5 / 8.7e-4 / 0.0033).
 TEST(Integrators, ImplicitRungeKuttaStepsThroughAnOverdampedMode) {
-  std::string scene = testing::point_mass_tip(0.04, 1000.0);
-  const size_t at = scene.find(R"("section": "sq")");
-  ASSERT_NE(at, std::string::npos);
-  scene.insert(at, R"("damping": 0.001, )");
+  const std::string scene = testing::point_mass_tip(0.04, 1000.0, 0.001);
   const Model model = scene_from_json(scene);
   const int tip = body_index(model, "tip");
-  TransientOptions tight_modal = options(0.3, 1e-3, 1e-10, 1e-14);
-  tight_modal.integrator.method = IntegratorMethod::kAuto;
-  const TransientRun reference = simulate(model, tight_modal);
-  ASSERT_TRUE(reference.result.ok) << reference.result.message;
-  ASSERT_EQ(reference.result.phases.size(), 1u);
-  ASSERT_EQ(reference.result.phases[0].method, "modal");
+  TransientRun reference;
+  ASSERT_NO_FATAL_FAILURE(tight_modal_run(model, 0.3, 1e-14, &reference));
   expect_dirk_within_rtol(model, reference, tip, options(0.3, 1e-3, 1.0, 1e-4), {1e-4, 1e-6, 1e-8},
                           "overdamped point-mass tip");
 
   // The same cantilever on a shaker driven at 0.2 m/s, 20 Hz: auto runs dirk (a driven body),
   // and failed so at rtol 1e-4; now 0.0034 / 0.0090 rtol of its motion at rtol 1e-4 / 1e-6 against
-  // bdf at rtol 1e-10.
+  // bdf at rtol 1e-10 (5.2e-5 / 0.0031 since the steps end on the outputs).
   std::string shaken = scene;
   const std::string ground = R"("body1": "ground")";
   shaken.replace(shaken.find(ground), ground.size(), R"("body1": "shaker")");
@@ -335,26 +342,10 @@ TEST(Integrators, ImplicitRungeKuttaStepsThroughAnOverdampedMode) {
 // / 1.3, now 1.8e-5 / 0.0029 (and 0.0045 at 1e-8), its steps ended on the outputs where they
 // outgrew the spacing.
 TEST(Integrators, OutputsAreStepsNotInterpolants) {
-  std::string scene = testing::point_mass_tip(0.01, 1.0);
-  const size_t at = scene.find(R"("section": "sq")");
-  ASSERT_NE(at, std::string::npos);
-  scene.insert(at, R"("damping": 0.01, )");
-  const std::string unloaded_z = R"(, 0], "time")";
-  const size_t load = scene.find(unloaded_z);
-  ASSERT_NE(load, std::string::npos);
-  scene.replace(load, unloaded_z.size(), R"(, 0.3], "time")");
-  const std::string massless = R"("G": 8.0769e10})";
-  const size_t steel = scene.find(massless);
-  ASSERT_NE(steel, std::string::npos);
-  scene.replace(steel, massless.size(), R"("G": 8.0769e10, "density": 7850})");
-  const Model model = scene_from_json(scene);
+  const Model model = scene_from_json(testing::point_mass_tip(0.01, 1.0, 0.01, 0.3, 7850.0));
   const int tip = body_index(model, "tip");
-  TransientOptions tight_modal = options(0.2, 1e-3, 1e-10, 1e-15);
-  tight_modal.integrator.method = IntegratorMethod::kAuto;
-  const TransientRun reference = simulate(model, tight_modal);
-  ASSERT_TRUE(reference.result.ok) << reference.result.message;
-  ASSERT_EQ(reference.result.phases.size(), 1u);
-  ASSERT_EQ(reference.result.phases[0].method, "modal");
+  TransientRun reference;
+  ASSERT_NO_FATAL_FAILURE(tight_modal_run(model, 0.2, 1e-15, &reference));
   // Each run must end at least one step on each of the 200 outputs.
   TransientOptions o = options(0.2, 1e-3, 1e-4, 1e-10);
   o.integrator.method = IntegratorMethod::kDirk;
@@ -380,7 +371,8 @@ TEST(Integrators, OutputsAreStepsNotInterpolants) {
 // A driven hub spins a 10 m beam (the spin-up of studies/spin_up.json, in 10 segments, up to
 // 6 rad/s over 2 s, 3 s): auto runs dirk (a moving support). Its tip against a tight explicit run,
 // in error weights rtol x 10 m: with the stage derivatives deduced 32 / 87 / 3.3 at rtol 1e-4 /
-// 1e-5 / 1e-6, silent; now 0.05 / 0.22 / 0.13.
+// 1e-5 / 1e-6, silent; now 0.05 / 0.22 / 0.13 (0.054 / 0.15 / 0.061 since the steps end on the
+// outputs).
 TEST(Integrators, ADrivenSpinUpFollowsRtol) {
   const Model model = scene_from_json(R"({
     "materials": {"rod": {"E": 2.8e7, "G": 1.0e7, "density": 1.2}},

@@ -302,7 +302,8 @@ class Runner {
     if (table) report.tables = {file};
 
     std::string verification = verification_reason(spec, model, options);
-    // auto may yet relinearize (verified_after_the_run): the trajectory is kept.
+    // auto may yet relinearize or hand a phase to bdf (verified_after_the_run): the trajectory
+    // is kept.
     const bool verify = !verification.empty() || may_verify_after_the_run(spec, options);
     Trajectory trajectory = trajectory_of(model, output_rows(options));
     bool first = true;
@@ -359,7 +360,7 @@ class Runner {
     if (report.ok && !(report.max_frequency_hz > 0.0) && !rail_floored(data))
       add_warnings({energy_drift_warning(spec, model, options, report.energy_max_change, energy,
                                          result.stats.steps)});
-    if (verification.empty()) verification = verified_after_the_run(spec, options, result);
+    if (verification.empty()) verification = verified_after_the_run(spec, model, options, result);
     if (report.ok && !verification.empty()) {
       report.verification = rerun_tighter(model, options, trajectory, result.stats);
       report.verification->reason = verification;

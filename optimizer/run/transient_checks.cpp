@@ -6,6 +6,7 @@
 
 #include "core/analysis/modal_step_bounds.hpp"
 #include "core/model/forces.hpp"
+#include "optimizer/run/number_text.hpp"
 
 namespace beamrail {
 namespace {
@@ -15,6 +16,22 @@ std::string two_digits(double x) {
   std::snprintf(text, sizeof text, x >= 99.5 ? "%.0f" : "%.2g", x);
   return text;
 }
+
+// Whether a method is one of CVODE's multistep methods, by name ("bdf", "adams") or as a phase
+// of an auto run ("bdf", ...).
+bool multistep(IntegratorMethod method) {
+  return method == IntegratorMethod::kBdf || method == IntegratorMethod::kAdams;
+}
+
+bool multistep(const std::string& phase_method) {
+  return phase_method.rfind("bdf", 0) == 0 || phase_method.rfind("adams", 0) == 0;
+}
+
+// What a multistep run's verification says of why: where CVODE's error control was found off.
+const char kMultistepFindings[] =
+    "whose error control was found up to 61 times its tolerance off without a sign on scenes "
+    "that are no mechanism (a free body under follower loads, a damped tip on a cantilever: "
+    "README \"Multistep runs verify themselves\")";
 
 }  // namespace
 
@@ -52,13 +69,18 @@ std::string energy_drift_warning(const AnalysisSpec& spec, const Model& model,
 }
 
 // Why the transient is verified (summary.json verification.reason), "" when it is not: asked
-// ("verify": true), or by default ("auto") where its scene moves as a mechanism (a body not held
-// by beams and fixed joints to the ground, and not part of a floating part: a pendulum on a
-// joint, a carriage on a rail) and its steps are adaptive. There every method's error control
-// was found silently off, by up to 1e4 times rtol, where no other check saw it (README
-// "Mechanisms verify themselves"); a rerun at rtol / 10 measured each such run's error and
-// warned of every one beyond 10 times its tolerance. It costs the rerun: 1.8 times the run's
-// time at the median of 63 review runs, at most 2.5 times in 45 of them, 65 times at worst.
+// ("verify": true), or by default ("auto") where its steps are adaptive and
+// - its scene moves as a mechanism (a body not held by beams and fixed joints to the ground, and
+//   not part of a floating part: a pendulum on a joint, a carriage on a rail). There every
+//   method's error control was found silently off, by up to 1e4 times rtol, where no other check
+//   saw it (README "Mechanisms verify themselves"); a rerun at rtol / 10 measured each such run's
+//   error and warned of every one beyond 10 times its tolerance. It costs the rerun: 1.8 times
+//   the run's time at the median of 63 review runs, at most 2.5 times in 45 of them, 65 times at
+//   worst;
+// - or bdf or adams integrates it (by name) and a body is free. Their error on structures and
+//   free bodies was found up to 61 times the tolerance off, silent, and their reruns at rtol / 10
+//   measured it within 0.77 to 1.09 of the error against tight independent runs (README "Multistep
+//   runs verify themselves"), at about the run's own cost.
 std::string verification_reason(const AnalysisSpec& spec, const Model& model,
                                 const TransientOptions& options) {
   switch (spec.verify) {
@@ -69,10 +91,16 @@ std::string verification_reason(const AnalysisSpec& spec, const Model& model,
     case AnalysisSpec::Verify::kAuto:
       break;
   }
-  if (options.integrator.fixed_step > 0.0 || !moves_as_mechanism(model)) return "";
-  return "\"verify\": \"auto\", the default: bodies move as a mechanism (not held by beams "
-         "and fixed joints to the ground), where error control was found far off without a "
-         "sign; \"verify\": false skips the rerun";
+  if (options.integrator.fixed_step > 0.0) return "";
+  if (moves_as_mechanism(model))
+    return "\"verify\": \"auto\", the default: bodies move as a mechanism (not held by beams "
+           "and fixed joints to the ground), where error control was found far off without a "
+           "sign; \"verify\": false skips the rerun";
+  if (multistep(options.integrator.method) && model.n_free() > 0)
+    return std::string("\"verify\": \"auto\", the default: ") +
+           method_name(options.integrator.method) + " integrates the run, " + kMultistepFindings +
+           "; \"verify\": false skips the rerun";
+  return "";
 }
 
 // Whether a transient that verification_reason does not verify may be verified after its run
@@ -83,20 +111,28 @@ bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& 
 }
 
 // Why a transient is verified after its run, "" when it is not: by default ("auto") an auto run
-// that relinearized as a body turned its limit. Its motion is then not a small one about a
+// - that handed a phase to bdf (damping that couples the modes, a modal method that could not
+//   start), for the reason verification_reason verifies bdf by name;
+// - or that relinearized as a body turned its limit. Its motion is then not a small one about a
 // configuration, where the modal method's error estimates were measured to hold; along large
 // motions the error can grow far past rtol with no other sign: an L-frame (a 1 m steel
 // cantilever in 5 segments, a 0.6 m leg from its 1 kg tip to a 2 kg foot, the tip started at
 // 2.2 m/s; an adversarial review, 2026-11-30) came out 10 / 1,150 rtol off at rtol 1e-3 / 1e-5
 // against Verner at rtol 1e-11, warned only of its model (the beams' axial forces), and its
 // reruns measured 13 / 1,022 (README "Large motions verify themselves"). Not where auto only
-// handed over to another method after a failed modal phase: a 100-segment cantilever whose band
+// handed over to dirk after a failed modal phase: a 100-segment cantilever whose band
 // failed at 3 us ran dirk, and its rerun at rtol 1e-7 was itself 21 times farther off than the
 // run (a false alarm).
-std::string verified_after_the_run(const AnalysisSpec& spec, const TransientOptions& options,
-                                   const TransientResult& result) {
-  if (!may_verify_after_the_run(spec, options) ||
-      std::none_of(result.phases.begin(), result.phases.end(),
+std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
+                                   const TransientOptions& options, const TransientResult& result) {
+  if (!may_verify_after_the_run(spec, options)) return "";
+  const auto phase = std::find_if(result.phases.begin(), result.phases.end(),
+                                  [](const MethodPhase& p) { return multistep(p.method); });
+  if (phase != result.phases.end() && model.n_free() > 0)
+    return "\"verify\": \"auto\", the default: auto handed the run to " + phase->method +
+           " at t = " + format_number(phase->t) + " s, " + kMultistepFindings +
+           "; \"verify\": false skips the rerun";
+  if (std::none_of(result.phases.begin(), result.phases.end(),
                    [](const MethodPhase& p) { return p.relinearized; }))
     return "";
   return "\"verify\": \"auto\", the default: the run relinearized as bodies turned (" +

@@ -54,16 +54,17 @@ std::string energy_drift_warning(const AnalysisSpec& spec, const Model& model,
                                  const EnergyScales& energy, long steps);
 
 // Why a transient is verified before its run (summary.json verification.reason), "" when it is
-// not: asked, or by default where its scene moves as a mechanism.
+// not: asked, or by default where its scene moves as a mechanism or bdf or adams integrates it.
 std::string verification_reason(const AnalysisSpec& spec, const Model& model,
                                 const TransientOptions& options);
 
 // Whether a transient that verification_reason does not verify may be verified after its run.
 bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& options);
 
-// Why a transient is verified after its run ("" when it is not): an auto run that relinearized.
-std::string verified_after_the_run(const AnalysisSpec& spec, const TransientOptions& options,
-                                   const TransientResult& result);
+// Why a transient is verified after its run ("" when it is not): an auto run that handed a phase
+// to bdf, or that relinearized.
+std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
+                                   const TransientOptions& options, const TransientResult& result);
 
 // The warning of a verification rerun farther from the run than kDriftTolerance times its
 // tolerance, or that failed.

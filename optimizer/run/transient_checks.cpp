@@ -157,8 +157,14 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
   if (!v.ok) {
     // A rerun that did not finish measured nothing (the run at rtol 1e-8 of a carriage with a
     // pendulum under a harmonic force: its rerun spent max_steps in 50 s, the run took 10 s).
+    // Verified by default, the user did not ask for it: say how to skip it (a sweep whose
+    // designs fit max_seconds_per_design but whose reruns do not warned on every row; an
+    // adversarial review of bdf's verification, 2026-11-30).
+    const bool by_default = v.reason.rfind("\"verify\": \"auto\"", 0) == 0;
     return "transient \"" + spec.name + "\": the verification rerun failed (" + v.message +
-           "): the run's error is not measured";
+           "): the run's error is not measured" +
+           (by_default ? "; give it more max_seconds or max_steps, or \"verify\": false skips it"
+                       : "");
   }
   if (options.integrator.fixed_step > 0.0) return "";
   std::string what;
@@ -177,8 +183,13 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
             two_digits(angle / v.turned / rtol) + " rtol of the " + two_digits(v.turned) +
             " rad turned)";
   if (what.empty()) return "";
+  // bdf's and adams' error need not fall with rtol (a damped spinning pair under bdf: 2 to 5,400
+  // tolerances off over rtol 1e-4 .. 1e-10, growing as rtol shrinks; an adversarial review,
+  // 2026-11-30), so for them another method is the other way out.
+  const bool multistep_by_name = multistep(options.integrator.method);
   return "transient \"" + spec.name + "\": the verification rerun at rtol / 10 moved " + what +
-         ": the run is not within its tolerance; run it at a smaller rtol";
+         ": the run is not within its tolerance; run it at a smaller rtol" +
+         (multistep_by_name ? " or with another method (auto, dirk)" : "");
 }
 
 }  // namespace beamrail

@@ -171,6 +171,12 @@ TEST_F(MechanismVerification, ARerunThatFailsWarnsThatNothingWasMeasured) {
     warned =
         warned || w.get<std::string>().find("the verification rerun failed (") != std::string::npos;
   EXPECT_TRUE(warned) << summary.dump(2);
+  // Verified by default, not asked for: the warning says how to skip the rerun.
+  bool skippable = false;
+  for (const Json& w : summary["warnings"])
+    skippable = skippable ||
+                w.get<std::string>().find("or \"verify\": false skips it") != std::string::npos;
+  EXPECT_TRUE(skippable) << summary.dump(2);
 }
 
 // A rotor spinning freely at 5 rad/s on a revolute joint turns 10 rad in 2 s; its centre stays,

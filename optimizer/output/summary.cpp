@@ -135,6 +135,8 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
              "largest angle between body orientations of the run and of the tighter run, "
              "relative to the largest angle a body turned (null when none turns more than 1e-9 "
              "rad)"},
+            {"tolerances", json_number(v->tolerances)},
+            {"rotation_tolerances", json_number(v->rotation_tolerances)},
             {"wall_seconds", v->stats.wall_seconds},
             {"steps", v->stats.steps},
             {"rhs_evaluations", v->stats.rhs_evaluations},

@@ -364,6 +364,7 @@ class Runner {
     if (report.ok && !verification.empty()) {
       report.verification = rerun_tighter(model, options, trajectory, result.stats);
       report.verification->reason = verification;
+      weigh_verification(options, &*report.verification);
       if (stop_requested() && !report.verification->ok) {
         report.ok = false;
         report.interrupted = true;

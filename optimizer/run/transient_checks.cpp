@@ -142,19 +142,31 @@ std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
          "\"verify\": false skips the rerun";
 }
 
+// The distances in multiples of the tolerance: in the centres rtol x + atol, x the rerun's
+// largest motion [m]; in the orientations rtol max(x, 1 rad) + atol radians, x the largest angle
+// a body of the rerun turned along its samples (every method weights a rotation absolutely,
+// about rtol radians per step: a carriage tilting 3.7e-4 rad on a rail was 4.8e-8 rad off at
+// rtol 1e-6, 129 rtol of its turn; a spin's phase error grows with the angle turned: the
+// tumbling pair's 27 rad, about 3 rtol per radian). The orientations only where successive
+// samples are within kLongestSampledTurn (else a sample may have skipped a turn and the angle
+// turned is not known: turned is NaN); the centres still count there. A fixed step's error is
+// not its tolerances': NaN.
+void weigh_verification(const TransientOptions& options, Verification* v) {
+  const double rtol = options.integrator.rtol, atol = options.integrator.atol;
+  v->tolerances = v->rotation_tolerances = std::numeric_limits<double>::quiet_NaN();
+  if (!v->ok || options.integrator.fixed_step > 0.0) return;
+  if (v->motion > 0.0) v->tolerances = v->error * v->motion / (rtol * v->motion + atol);
+  if (v->turned > 0.0)
+    v->rotation_tolerances =
+        v->rotation_error * v->turn / (rtol * std::max(v->turned, 1.0) + atol);  // [rad] / [rad]
+}
+
 // The warning of a verification rerun farther from the run than kDriftTolerance times its
-// tolerance ("" when it is within it, or for a fixed step; a rerun that failed warns that it
-// measured nothing): in the
-// centres rtol x + atol, x the rerun's largest motion [m]; in the orientations rtol max(x, 1 rad)
-// + atol radians, x the largest angle a body of the rerun turned along its samples (every
-// method weights a rotation absolutely, about rtol radians per step: a carriage tilting 3.7e-4
-// rad on a rail was 4.8e-8 rad off at rtol 1e-6, 129 rtol of its turn; a spin's phase error
-// grows with the angle turned: the tumbling pair's 27 rad, about 3 rtol per radian). The
-// orientations only where successive samples are within kLongestSampledTurn (else a sample may
-// have skipped a turn and the angle turned is not known); the centres still count there.
+// tolerance (weigh_verification; "" when it is within it, or for a fixed step; a rerun that
+// failed warns that it measured nothing).
 std::string verification_warning(const AnalysisSpec& spec, const TransientOptions& options,
                                  const Verification& v) {
-  const double rtol = options.integrator.rtol, atol = options.integrator.atol;
+  const double rtol = options.integrator.rtol;
   if (!v.ok) {
     // A rerun that did not finish measured nothing (the run at rtol 1e-8 of a carriage with a
     // pendulum under a harmonic force: its rerun spent max_steps in 50 s, the run took 10 s).
@@ -171,18 +183,17 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
   std::string what;
   // Each figure also in multiples of the tolerance, which decides: where atol dominates it, the
   // rtol figure alone reads far larger (a bob swinging 78 um: 1.8e4 rtol, 140 tolerances).
-  const double centres = v.error * v.motion / (rtol * v.motion + atol);
-  if (v.motion > 0.0 && centres > kDriftTolerance)
+  if (v.tolerances > kDriftTolerance)
     what = "the body centres by " + two_digits(v.error) + " of their motion (" +
-           two_digits(centres) + " times their tolerance rtol x + atol; " +
+           two_digits(v.tolerances) + " times their tolerance rtol x + atol; " +
            two_digits(v.error / rtol) + " rtol)";
-  const double angle = v.rotation_error * v.turn;  // [rad]
-  const double orientations = angle / (rtol * std::max(v.turned, 1.0) + atol);
-  if (v.turned > 0.0 && orientations > kDriftTolerance)
+  if (v.rotation_tolerances > kDriftTolerance) {
+    const double angle = v.rotation_error * v.turn;  // [rad]
     what += (what.empty() ? "" : " and ") + std::string("the orientations by ") +
-            two_digits(angle) + " rad (" + two_digits(orientations) + " times their tolerance; " +
-            two_digits(angle / v.turned / rtol) + " rtol of the " + two_digits(v.turned) +
-            " rad turned)";
+            two_digits(angle) + " rad (" + two_digits(v.rotation_tolerances) +
+            " times their tolerance; " + two_digits(angle / v.turned / rtol) + " rtol of the " +
+            two_digits(v.turned) + " rad turned)";
+  }
   if (what.empty()) return "";
   // bdf's and adams' error need not fall with rtol (a damped spinning pair under bdf: 2 to 5,400
   // tolerances off over rtol 1e-4 .. 1e-10, growing as rtol shrinks; an adversarial review,

@@ -4,6 +4,7 @@
 // found). Each warning is "" where there is nothing to say.
 #pragma once
 
+#include <limits>
 #include <string>
 
 #include "core/analysis/transient.hpp"
@@ -28,6 +29,10 @@ struct Verification {
   // along its samples [rad; NaN when its samples may have skipped a turn]: what the errors are
   // measured against.
   double motion = 0.0, turn = 0.0, turned = 0.0;
+  // The distances between the runs in multiples of the run's tolerance, as the warning weighs
+  // them (weigh_verification): NaN where not measured, and for a fixed step.
+  double tolerances = std::numeric_limits<double>::quiet_NaN();
+  double rotation_tolerances = std::numeric_limits<double>::quiet_NaN();
   SolverStats stats;   // of the tighter run
   std::string reason;  // why the run was verified: asked, or "verify": "auto"
 };
@@ -65,6 +70,9 @@ bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& 
 // to bdf, or that relinearized.
 std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
                                    const TransientOptions& options, const TransientResult& result);
+
+// Sets v's distances in multiples of the tolerance of the run (options): the warning's measure.
+void weigh_verification(const TransientOptions& options, Verification* v);
 
 // The warning of a verification rerun farther from the run than kDriftTolerance times its
 // tolerance, or that failed.

@@ -215,6 +215,8 @@ TEST_F(MechanismVerification, ASpinsPhaseIsWeighedAgainstTheAngleTurned) {
       "+ atol); the rerun: %s\n",
       error, error / tolerance, v.dump().c_str());
   EXPECT_GT(error, 10.0 * tolerance);
+  // The orientations' distance in multiples of their tolerance, the figure the warning quotes.
+  EXPECT_GT(v["rotation_tolerances"].get<double>(), 10.0) << v.dump(2);
   ASSERT_TRUE(summary.contains("warnings")) << summary.dump(2);
   bool warned = false;
   for (const Json& w : summary["warnings"])

@@ -94,6 +94,9 @@ TEST_F(MultistepVerification, BdfByNameVerifiesItselfAndWarnsWhereItIsOff) {
   EXPECT_GT(d.centres, 10.0 * tolerance);
   EXPECT_GT(estimate, 0.7 * d.centres);
   EXPECT_LT(estimate, 1.3 * d.centres);
+  // The distance in multiples of the tolerance, as the warning weighs it (against the rerun's
+  // motion, within 1 % of the reference's here).
+  EXPECT_NEAR(v["tolerances"].get<double>(), estimate / tolerance, 0.01 * estimate / tolerance);
   EXPECT_NE(v["reason"].get<std::string>().find("bdf integrates the run"), std::string::npos)
       << v.dump(2);
   EXPECT_TRUE(warns_off_tolerance(far)) << far.dump(2);
@@ -111,7 +114,8 @@ TEST_F(MultistepVerification, BdfByNameVerifiesItselfAndWarnsWhereItIsOff) {
               l.centres / (1e-4 * l.motion + 1e-10),
               right["analyses"][0]["verification"].dump().c_str());
   EXPECT_LT(l.centres, 10.0 * (1e-4 * l.motion + 1e-10));
-  EXPECT_TRUE(right["analyses"][0].contains("verification")) << right.dump(2);
+  ASSERT_TRUE(right["analyses"][0].contains("verification")) << right.dump(2);
+  EXPECT_LT(right["analyses"][0]["verification"]["tolerances"].get<double>(), 10.0);
   EXPECT_FALSE(warns_off_tolerance(right)) << right.dump(2);
 
   const Json quiet =

@@ -219,6 +219,9 @@ TEST_F(SpeedAccuracyRuns, VerifyHalvesAFixedStep) {
   EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-8);  // the Newton tolerance kept
   EXPECT_EQ(summary["analyses"][0]["steps"], 50);   // 0.02 s
   EXPECT_EQ(v["steps"], 100);
+  // A fixed step's error is not its tolerances': not weighed against them.
+  EXPECT_TRUE(v["tolerances"].is_null()) << v.dump(2);
+  EXPECT_TRUE(v["rotation_tolerances"].is_null()) << v.dump(2);
   const double estimate = v["error"];
   std::printf(
       "dirk fixed step 4e-4 s: error %.4g against rtol 1e-11, %.4g against 2e-4 s "

@@ -69,12 +69,12 @@ class AutoIntegrator : public Integrator {
     // rtol at rtol 1e-4, from the start 0.0017). Floating parts (relinearized, or followed in a
     // turning frame) keep the modal method: there bdf drifts (a damped tumbling pair 10 to 18
     // rtol, the modal method 0.04 to 0.8).
-    // Why dirk and not bdf (measured 2026-11-30 against Verner at rtol 1e-11, 0.1 s, README
-    // "Damped mechanisms"): bdf left flexible pendulums (a rod of 5 mm steel between an arm on a
-    // joint and a 0.1 kg tip) 8 to 51 rtol off at rtol 1e-4, silent, and took 1.4 to 3.3 million
-    // steps (8 to 54 s) at rtol 1e-6, where their barely damped fast modes keep its higher orders
-    // unstable; dirk (A-stable) was within 0.004 rtol at rtol 1e-4 and 1e-6 in 0.08 to 0.6 s, and
-    // 0.01 at 1e-8 (1.7 to 26 s, bdf 8.8 to 54 s).
+    // Why dirk and not bdf (measured 2026-11-30 against Verner at rtol 1e-11, 0.1 s,
+    // docs/transient_measurements.md "Damped mechanisms"): bdf left flexible pendulums (a rod of 5
+    // mm steel between an arm on a joint and a 0.1 kg tip) 8 to 51 rtol off at rtol 1e-4, silent,
+    // and took 1.4 to 3.3 million steps (8 to 54 s) at rtol 1e-6, where their barely damped fast
+    // modes keep its higher orders unstable; dirk (A-stable) was within 0.004 rtol at rtol 1e-4 and
+    // 1e-6 in 0.08 to 0.6 s, and 0.01 at 1e-8 (1.7 to 26 s, bdf 8.8 to 54 s).
     if (largest_damping(model) > 0.0 && !held_by_beams(model) && floating_parts(model).empty())
       return start_method(IntegratorMethod::kDirk, "", 0.0, y0,
                           "damping, and bodies that move as a mechanism (not held by beams and "

@@ -62,7 +62,8 @@ inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
 // modal/bdf wall 0.16 at a ratio of 0.01, 0.41 at 0.05, 2.6 at 0.21, 9.3 at 0.83. With each
 // mode's own damping exact, one `damping` for every member keeps the modal method at any
 // strength: there bdf was 8 to 161 rtol off on the lightly damped cantilevers of an adversarial
-// review (2026-11-29), the modal method within 1 rtol (README "Damped modes exact").
+// review (2026-11-29), the modal method within 1 rtol (docs/transient_measurements.md "Damped modes
+// exact").
 inline constexpr double kAutoMaxDampingRatio = 0.1;
 
 // A modal phase (every mode integrated) that moved a mechanism (a body not held by beams and

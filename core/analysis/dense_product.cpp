@@ -198,8 +198,8 @@ bool has_avx512() { return false; }
 // The pair in 8 lanes where the CPU has AVX-512 (one register, fused multiply-adds: 4 lanes there
 // were multiplications and additions), 4 lanes else. Measured on an AVX-512 machine (AMD EPYC), a
 // standalone copy of both, medians of 15 runs of 20, interleaved, three times: n = 1,038 158, 144
-// and 162 us against 214, 164 and 167 us; n = 600 49 against 60 us. The tower's run: README "One
-// pass over Phi per stage".
+// and 162 us against 214, 164 and 167 us; n = 600 49 against 60 us. The tower's run:
+// docs/transient_measurements.md "One pass over Phi per stage".
 BEAMRAIL_AVX512 void pair_kernel_avx512(long rows, long cols, const double* a, long lda,
                                         const double* x, double* y, long ldy) {
   wide_kernel<2, 8>(rows, cols, a, lda, x, y, ldy);

@@ -75,16 +75,16 @@ inline void apply_add(const ModeFunction& f, const ModeBlocks& blocks, const Mod
 // The coefficient functions of one step of size h of the stiff-order-4 exponential Runge-Kutta
 // method (5 stages, c = 0, 1/2, 1/2, 1, 1/2):
 //   Z_i = E(c_i h) z + h sum_j a_ij N_j,   z+ = E(h) z + h sum_j b_j N_j.
-// Why five stages (measured 2026-11-27, README "The tower over rtol and atol"): the four-stage
-// methods of Krogstad and of Strehmel and Weiner (c = 0, 1/2, 1/2, 1; stiff order 3) save one
-// evaluation and two products per step; Krogstad's ran the README's braced tower at rtol 1e-6,
-// atol 1e-9 in 6.75 against 8.10 s with the same steps (3,972 against 3,970) and errors
-// (rotations 5.7e-6 against 5.5e-6). But their stages give no embedded third-order solution
-// other than the method's own, so only the second-order estimate controlled the step, and on
-// rotating scenes the errors of both grew: the tumbling pair 3.8 .. 6.6 rtol in its centres
-// (this method 0.08 .. 0.39; with only its second-order estimate 0.11 .. 3.4), the fast spin of
-// transient_auto_test.cpp 36 rtol, the bob hinged to a cantilever (joint_transient_test.cpp) 36
-// rtol at rtol 1e-7, the tumbling pair's energy over 10 s 955 rtol.
+// Why five stages (measured 2026-11-27, docs/transient_measurements.md "The tower over rtol and
+// atol"): the four-stage methods of Krogstad and of Strehmel and Weiner (c = 0, 1/2, 1/2, 1; stiff
+// order 3) save one evaluation and two products per step; Krogstad's ran the braced tower of
+// docs/transient_measurements.md at rtol 1e-6, atol 1e-9 in 6.75 against 8.10 s with the same steps
+// (3,972 against 3,970) and errors (rotations 5.7e-6 against 5.5e-6). But their stages give no
+// embedded third-order solution other than the method's own, so only the second-order estimate
+// controlled the step, and on rotating scenes the errors of both grew: the tumbling pair 3.8 .. 6.6
+// rtol in its centres (this method 0.08 .. 0.39; with only its second-order estimate 0.11 .. 3.4),
+// the fast spin of transient_auto_test.cpp 36 rtol, the bob hinged to a cantilever
+// (joint_transient_test.cpp) 36 rtol at rtol 1e-7, the tumbling pair's energy over 10 s 955 rtol.
 // Measured again (2026-11-30) with an embedded third-order solution for Krogstad's method (stage
 // 3 alone with weight 4 phi2 - 8 phi3 where the method takes stages 2 and 3 with 2 phi2 - 4 phi3
 // each: the distance h (2 phi2 - 4 phi3) (N2 - N3)), used where no part turns with a frame and no

@@ -294,7 +294,8 @@ class Cvode : public SundialsIntegrator {
     // rtol off (follower_load_test.cpp), and on the 40 mm tip under 1 kN with beam damping 1e-2 s
     // at rtol 1e-8 from 3.8 to 9.8 tolerances; ending them only so, 14 and 3.8. Where the steps
     // sit near the spacing the cuts still perturb it: that free body at rtol 1e-8 with outputs
-    // every 0.02 s went from 10 to 40 tolerances (README "dirk's outputs are steps").
+    // every 0.02 s went from 10 to 40 tolerances (docs/transient_measurements.md "dirk's outputs
+    // are steps").
     double now = 0.0, next_step = 0.0;
     CVodeGetCurrentTime(mem_, &now);
     CVodeGetCurrentStep(mem_, &next_step);

@@ -421,10 +421,11 @@ bool solve_band_modes(const Model& model, const Data& data, double t0,
     return true;
   };
   // Up to kModalIntegratorMaxDofs, when no band of the modes Lanczos gives meets rtol, every mode
-  // from the dense eigensolver (README "Every mode where no band meets rtol"). Its estimate counts
-  // each mode above a band apart where Lanczos's sums the static response of the modes beyond
-  // those given: with every mode at once, the 201-segment cantilever at rtol 1e-6 needed all
-  // 1,206 modes (5.0 s) where 192 from Lanczos chose 155 (1.3 s; 0.25 rtol off).
+  // from the dense eigensolver (docs/transient_measurements.md "Every mode where no band meets
+  // rtol"). Its estimate counts each mode above a band apart where Lanczos's sums the static
+  // response of the modes beyond those given: with every mode at once, the 201-segment cantilever
+  // at rtol 1e-6 needed all 1,206 modes (5.0 s) where 192 from Lanczos chose 155 (1.3 s; 0.25 rtol
+  // off).
   const bool dense_after = choose && n <= kModalIntegratorMaxDofs;
   if (n <= kModalDenseBandMaxDofs) {
     if (!dense()) return false;

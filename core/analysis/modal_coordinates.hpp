@@ -14,9 +14,9 @@
 // fixed axes it is a second-order offset along the stiff modes that the exponential method treats
 // as an explicit remainder of size K0 x offset (a free pair on a steel rod spinning at 8 rad/s:
 // 6.6e3 N standing for 0.34 N of centripetal force), whose error its estimates miss (12 to 537
-// rtol measured at rtol 1e-4 .. 1e-8, README "Floating scenes turn with their frame"). The frame
-// adds the centrifugal and Coriolis accelerations, -W x (W x p) - 2 W x dp/dt, and
-// omega_frame = omega - A^T W in body axes, all exact.
+// rtol measured at rtol 1e-4 .. 1e-8, docs/transient_measurements.md "Floating scenes turn with
+// their frame"). The frame adds the centrifugal and Coriolis accelerations, -W x (W x p) - 2 W x
+// dp/dt, and omega_frame = omega - A^T W in body axes, all exact.
 #pragma once
 
 #include <Eigen/Core>

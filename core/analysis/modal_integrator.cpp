@@ -365,11 +365,12 @@ class ModalExponential : public Integrator {
   // N m torque at 2 Hz for 1 s, came out 611 times rtol x + atol off its closed form with the
   // step's weights (3e-5 m across the swing: y stopped within 3e-10 m of a joint of 6e12 N/m),
   // and 0.04 times with the bob at the origin and the joint above it (tests/core/analysis/
-  // transient_auto_test.cpp, TransientBand). What it costs: README "A band's quasi-static part,
-  // wherever the scene sits". Weights of each offset, rtol |x_i| + atol, are tighter still where
-  // an offset is small (along a chain's stiff axis) and took the 1,000-segment cantilever 115 s
-  // (these 107 s, the step's weights 73 s) for the same error; these weights with the iteration
-  // stopped at 1e-3 of them (kQuasiStaticTolerance) 84 s, but the bob 11 to 86 times off.
+  // transient_auto_test.cpp, TransientBand). What it costs: docs/transient_measurements.md "A
+  // band's quasi-static part, wherever the scene sits". Weights of each offset, rtol |x_i| + atol,
+  // are tighter still where an offset is small (along a chain's stiff axis) and took the
+  // 1,000-segment cantilever 115 s (these 107 s, the step's weights 73 s) for the same error; these
+  // weights with the iteration stopped at 1e-3 of them (kQuasiStaticTolerance) 84 s, but the bob 11
+  // to 86 times off.
   double correct(const Eigen::VectorXd& psi_a, Block& x) {
     m0_a_.noalias() = m0_ * acceleration_;
     const Eigen::VectorXd& dy = quasi_.correct(m0_a_, psi_a);
@@ -635,14 +636,14 @@ class ModalExponential : public Integrator {
   // reference cantilever in 10 segments, 0.017 .. 1.3 on that torsion case, 0.13 .. 1.9 on the
   // tumbling pair (relinearized, in fixed axes: since followed in a turning frame, 0.02 .. 0.13);
   // the second-order estimate alone gave 1e-2 .. 1e-5 rtol there.
-  // Where it costs: the braced tower of the README (1,038 dof, 2 kN step, rtol 1e-6, atol 1e-9,
-  // 0.2 s) takes 797 steps held by the second-order estimate, almost all of it in the angular
-  // velocities (atol-weighted: they are near zero), and leaves 0.03 rtol. The forcing there is
-  // the deflection times the fast modes (its steps follow the band's top: 246, 613, 786 and 797
-  // steps for bands of 300 Hz, 1 kHz, 3 kHz and every mode). Tried and rejected, measured with
-  // ErrorFollowsTheTolerance: the second-order estimate at 0.1 of its weight (tower 298 steps,
-  // 0.4 rtol) leaves 20 rtol on the step-torque case at rtol 1e-5; on positions only, or the
-  // third-order one alone (185 steps, 2.6 rtol), 16 .. 476 rtol there; from stages 1 and 4
+  // Where it costs: the braced tower of docs/transient_measurements.md (1,038 dof, 2 kN step,
+  // rtol 1e-6, atol 1e-9, 0.2 s) takes 797 steps held by the second-order estimate, almost all of
+  // it in the angular velocities (atol-weighted: they are near zero), and leaves 0.03 rtol. The
+  // forcing there is the deflection times the fast modes (its steps follow the band's top: 246,
+  // 613, 786 and 797 steps for bands of 300 Hz, 1 kHz, 3 kHz and every mode). Tried and rejected,
+  // measured with ErrorFollowsTheTolerance: the second-order estimate at 0.1 of its weight (tower
+  // 298 steps, 0.4 rtol) leaves 20 rtol on the step-torque case at rtol 1e-5; on positions only, or
+  // the third-order one alone (185 steps, 2.6 rtol), 16 .. 476 rtol there; from stages 1 and 4
   // (exponential trapezoid) instead of 1 and 2, 741 steps; weights rtol |omega| + atol per body:
   // 445 steps, 14 .. 99 rtol there (small bending rates beside the torsion set the deflection).
   static constexpr double kExponent = 0.25;

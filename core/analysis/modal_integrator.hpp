@@ -31,7 +31,7 @@
 // model's states: core/analysis/modal_coordinates.hpp.
 // The products use the threads of the caller's budget (ProductThreads,
 // core/analysis/dense_product.hpp): the tower's 1 s run took 14.3 s on 2 threads, 15.8 s on 1
-// (AVX2 kernels; README "Why this machine ran the tower slower").
+// (AVX2 kernels; docs/transient_measurements.md "Why this machine ran the tower slower").
 // Accuracy degrades with the size of the motion: past kMaxRotation the run stops with a message
 // naming the body. A part of the scene that floats and spins is followed in a frame turning with it
 // (core/analysis/modal_coordinates.hpp): its rigid spin is no motion away from the linearization
@@ -68,7 +68,7 @@ namespace beamrail {
 // Largest scene the modal integrator integrates every mode of [degrees of freedom = 6 per free
 // body]: one dense eigenproblem at set-up (~n^3) and products with the n x n basis (~n^2 per
 // stage); above it only a band (max_frequency_hz). Measured where auto takes it because no band
-// meets rtol: README "Every mode where no band meets rtol".
+// meets rtol: docs/transient_measurements.md "Every mode where no band meets rtol".
 inline constexpr int kModalIntegratorMaxDofs = 2400;
 // Up to this many degrees of freedom a band's modes come from the dense eigensolver, above from
 // shift-invert Lanczos (core/analysis/modal_band.hpp).

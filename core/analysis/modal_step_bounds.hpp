@@ -22,8 +22,9 @@ namespace beamrail {
 // / w_max: that error then follows rtol. Against an explicit Verner run at rtol 1e-11 three
 // such pairs (1.5 and 8 rad/s about the major axis, 8 along the rod) came out 0.005 .. 1.5 rtol
 // off over rtol 1e-4 .. 1e-8 (tests/core/analysis/turning_frame_test.cpp; without the bound up to
-// 378 rtol at 1e-8, and 12 .. 537 rtol in fixed axes: README "Floating scenes turn with their
-// frame"). The constants are fitted to the 8 rad/s pair: a faster spin couples more.
+// 378 rtol at 1e-8, and 12 .. 537 rtol in fixed axes: docs/transient_measurements.md "Floating
+// scenes turn with their frame"). The constants are fitted to the 8 rad/s pair: a faster spin
+// couples more.
 inline constexpr double kTurningFrameStep = 1.0;
 inline constexpr double kTurningFrameRtol = 1e-8;
 inline constexpr double kTurningFrameLongestStep = 3.0;
@@ -86,8 +87,8 @@ inline constexpr double kMechanismMostShorter = 100.0;
 // hinged below a cantilever (studies/hinged_bob.json) held half of it: 30 times the steps.
 // What 1e-5 costs on the reviews' mechanisms: at most 3.3 times the steps at rtol 1e-4 on a bob
 // on a joint of compliance 1e-9 (0.18 / 0.15 rtol off), 3.2 times at 1e-6 on the hinged bob
-// (both already right); many runs took fewer (README "A mechanism's ringing modes hold its
-// steps").
+// (both already right); many runs took fewer (docs/transient_measurements.md "A mechanism's ringing
+// modes hold its steps").
 inline constexpr double kMechanismRingingShare = 1e-5;
 // With a harmonic load of frequency f (the highest), the steps stay below kHarmonicStep
 // rtol^(1/4) / (2 pi f): the third-order estimate compares two evaluations at the same time
@@ -134,8 +135,8 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // its motion off at rtol 1e-4 / 1e-6 / 1e-8 (against Verner at rtol 1e-11), silent; with its
 // first step held so, 0.026 / 0.077 / 0.010. At every start (the run's, a load's jump, auto's
 // relinearization), at rest or not: a first form asked for exact rest, and a carriage nudged at
-// 1e-12 m/s along its rail kept the error. What it does on the reviews' other mechanisms: README
-// "A mechanism's first step from rest".
+// 1e-12 m/s along its rail kept the error. What it does on the reviews' other mechanisms:
+// docs/transient_measurements.md "A mechanism's first step from rest".
 ModeBlock ringing_about_static_state(const Eigen::ArrayXd& lambda, const ModeBlock& z,
                                      const Eigen::VectorXd& psi_a);
 

@@ -31,7 +31,8 @@ bool multistep(const std::string& phase_method) {
 const char kMultistepFindings[] =
     "whose error control was found up to 6,400 times its tolerance off without a sign on "
     "scenes that are no mechanism (damped spinning pairs, a free body under follower loads, a "
-    "damped tip on a cantilever: README \"Multistep runs verify themselves\")";
+    "damped tip on a cantilever: docs/transient_measurements.md \"Multistep runs verify "
+    "themselves\")";
 
 }  // namespace
 
@@ -48,9 +49,9 @@ bool rail_floored(const Data& data) {
 // drops the energy of the modes above it by design), and above the rounding of the energy's terms
 // over the steps (reference runs at rtol 1e-11 and below drift by rounding: a pendulum of 2.25
 // million steps by 1.5e-11 J of 3.8 J, a body 10 km above the origin by a few ulp of its
-// gravity energy). Measured (README "Energy drift and verify warn"): free elastic pairs
-// spinning, auto at rtol 1e-4 and 1e-6, drifts of 12 to 208 rtol where the motion was 12 to 537
-// rtol off; the tumbling pair within 7 rtol where its centres are within 2.
+// gravity energy). Measured (docs/transient_measurements.md "Energy drift and verify warn"): free
+// elastic pairs spinning, auto at rtol 1e-4 and 1e-6, drifts of 12 to 208 rtol where the motion was
+// 12 to 537 rtol off; the tumbling pair within 7 rtol where its centres are within 2.
 std::string energy_drift_warning(const AnalysisSpec& spec, const Model& model,
                                  const TransientOptions& options, double drift,
                                  const EnergyScales& energy, long steps) {
@@ -73,15 +74,16 @@ std::string energy_drift_warning(const AnalysisSpec& spec, const Model& model,
 // - its scene moves as a mechanism (a body not held by beams and fixed joints to the ground, and
 //   not part of a floating part: a pendulum on a joint, a carriage on a rail). There every
 //   method's error control was found silently off, by up to 1e4 times rtol, where no other check
-//   saw it (README "Mechanisms verify themselves"); a rerun at rtol / 10 measured each such run's
-//   error and warned of every one beyond 10 times its tolerance. It costs the rerun: 1.8 times
-//   the run's time at the median of 63 review runs, at most 2.5 times in 45 of them, 65 times at
-//   worst;
+//   saw it (docs/transient_measurements.md "Mechanisms verify themselves"); a rerun at rtol / 10
+//   measured each such run's error and warned of every one beyond 10 times its tolerance. It costs
+//   the rerun: 1.8 times the run's time at the median of 63 review runs, at most 2.5 times in 45 of
+//   them, 65 times at worst;
 // - or bdf or adams integrates it (by name) and a body is free. Their error on structures and
 //   free bodies was found up to 61 times the tolerance off, silent (damped spinning pairs: up to
 //   6,400), and their reruns at rtol / 10 measured 0.77 to 1.09 of it against tight independent
 //   runs (an adversarial review: 0.24 to 1.85, median 0.84, over 141 runs more than 10
-//   tolerances off; README "Multistep runs verify themselves"), at about the run's own cost.
+//   tolerances off; docs/transient_measurements.md "Multistep runs verify themselves"), at about
+//   the run's own cost.
 std::string verification_reason(const AnalysisSpec& spec, const Model& model,
                                 const TransientOptions& options) {
   switch (spec.verify) {
@@ -120,10 +122,10 @@ bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& 
 // cantilever in 5 segments, a 0.6 m leg from its 1 kg tip to a 2 kg foot, the tip started at
 // 2.2 m/s; an adversarial review, 2026-11-30) came out 10 / 1,150 rtol off at rtol 1e-3 / 1e-5
 // against Verner at rtol 1e-11, warned only of its model (the beams' axial forces), and its
-// reruns measured 13 / 1,022 (README "Large motions verify themselves"). Not where auto only
-// handed over to dirk after a failed modal phase: a 100-segment cantilever whose band
-// failed at 3 us ran dirk, and its rerun at rtol 1e-7 was itself 21 times farther off than the
-// run (a false alarm).
+// reruns measured 13 / 1,022 (docs/transient_measurements.md "Large motions verify themselves").
+// Not where auto only handed over to dirk after a failed modal phase: a 100-segment cantilever
+// whose band failed at 3 us ran dirk, and its rerun at rtol 1e-7 was itself 21 times farther off
+// than the run (a false alarm).
 std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
                                    const TransientOptions& options, const TransientResult& result) {
   if (!may_verify_after_the_run(spec, options)) return "";

@@ -193,7 +193,7 @@ bool read_static(ObjectReader& r, const Model* model, AnalysisSpec& a) {
   a.statics.tolerance = r.positive("tolerance", false).value_or(a.statics.tolerance);
   if (const auto n = r.integer("max_iterations", false, 1))
     a.statics.max_iterations = static_cast<int>(std::min(*n, 10000L));
-  // How the loads are raised (docs/study_files.md "Static analysis"): load steps, or along the
+  // How the loads are raised (docs/study_files.md, the `static` analysis): load steps, or along the
   // path by arc length (through limit points; the path in static_path.csv).
   if (const auto control = r.choice("control", false, {"load", "arc_length"}))
     a.statics.control = *control == "arc_length" ? StaticControl::kArcLength : StaticControl::kLoad;

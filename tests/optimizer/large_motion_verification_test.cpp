@@ -1,9 +1,9 @@
 // An auto run that relinearizes verifies itself by default ("verify": "auto"): where bodies turn
 // past the relinearization limit the motion is no small one about a configuration, and the error
-// can grow far past rtol with no other sign (README "Large motions verify themselves"). The scene
-// is the one an adversarial review found: an L-frame, a 1 m steel cantilever in 5 segments whose 1
-// kg tip carries a 0.6 m leg in 3 segments down to a 2 kg foot, the tip started at (0, 2, 1) m/s
-// under a constant 2 N, for 0.5 s.
+// can grow far past rtol with no other sign (docs/transient_measurements.md "Large motions verify
+// themselves"). The scene is the one an adversarial review found: an L-frame, a 1 m steel
+// cantilever in 5 segments whose 1 kg tip carries a 0.6 m leg in 3 segments down to a 2 kg foot,
+// the tip started at (0, 2, 1) m/s under a constant 2 N, for 0.5 s.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,8 +1,8 @@
 // A mechanism's transient verifies itself by default ("verify": "auto"): where bodies move as a
-// mechanism every method's error control was found silently off (README "Mechanisms verify
-// themselves"), so such a run is rerun at rtol / 10 and warns when the two are farther apart than
-// 10 times its tolerance. The scene is the worst case found: the stiff-joint bob of
-// tests/support/stiff_joint_bob.hpp, for 1 s.
+// mechanism every method's error control was found silently off (docs/transient_measurements.md
+// "Mechanisms verify themselves"), so such a run is rerun at rtol / 10 and warns when the two are
+// farther apart than 10 times its tolerance. The scene is the worst case found: the stiff-joint bob
+// of tests/support/stiff_joint_bob.hpp, for 1 s.
 #include <gtest/gtest.h>
 
 #include <algorithm>

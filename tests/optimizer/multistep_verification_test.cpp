@@ -1,10 +1,10 @@
 // bdf and adams verify themselves by default ("verify": "auto"): on scenes that are no mechanism
 // their error was found far off without a sign (a damped tip on a cantilever, a free body under
-// follower loads: up to 61 times the tolerance; damped spinning pairs: up to 6,400; README
-// "Multistep runs verify themselves"), so a run they integrate, by name or as a phase of auto, is
-// rerun at rtol / 10 and warns when the two are farther apart than 10 times its tolerance. The
-// scene: issue 17's point-mass tip on a 40 mm steel cantilever of its own mass, damped at 1e-3 s,
-// under a 1 kN step with a z part, for 0.2 s.
+// follower loads: up to 61 times the tolerance; damped spinning pairs: up to 6,400;
+// docs/transient_measurements.md "Multistep runs verify themselves"), so a run they integrate, by
+// name or as a phase of auto, is rerun at rtol / 10 and warns when the two are farther apart than
+// 10 times its tolerance. The scene: issue 17's point-mass tip on a 40 mm steel cantilever of its
+// own mass, damped at 1e-3 s, under a 1 kN step with a z part, for 0.2 s.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -126,7 +126,8 @@ TEST_F(MultistepVerification, BdfByNameVerifiesItselfAndWarnsWhereItIsOff) {
 }
 
 // adams by name is verified likewise; dirk by name on a structure is not (its rows are its steps,
-// and the damped tips were within 0.64 of their tolerance: README "dirk's outputs are steps").
+// and the damped tips were within 0.64 of their tolerance: docs/transient_measurements.md "dirk's
+// outputs are steps").
 TEST_F(MultistepVerification, AdamsIsVerifiedAndDirkIsNot) {
   Table adams, dirk;
   const Json a =

@@ -289,8 +289,8 @@ TEST(TransientAuto, DampingThatCouplesTheModesTakesBdf) {
 // Beyond the dense eigensolver's size for a band (kModalDenseBandMaxDofs), auto chooses a band
 // for rtol from Lanczos's modes (core/analysis/modal_band.hpp) and integrates the modes in it;
 // when no band of the modes it may ask for meets rtol, every mode up to kModalIntegratorMaxDofs
-// (once bdf: 187k steps where every mode took 1,366 at rtol 1e-7, README "Every mode where no
-// band meets rtol"), and bdf beyond.
+// (once bdf: 187k steps where every mode took 1,366 at rtol 1e-7, docs/transient_measurements.md
+// "Every mode where no band meets rtol"), and bdf beyond.
 TEST(TransientAuto, BeyondTheDenseLimitChoosesABandElseEveryModeElseBdf) {
   const int bodies = kModalDenseBandMaxDofs / kDofsPerBody + 1;
   const Model model = scene_from_json(reference_cantilever(bodies));
@@ -461,7 +461,7 @@ TEST(TransientAuto, TheLanczosBandMeetsRtolAgainstAFixedStepImplicitRun) {
   // At rtol 1e-7 no band of the kModalChosenBandMaxModes lowest modes meets rtol: every mode
   // (once bdf, 187k steps). This reference cannot measure its error (its own is about halving /
   // 2.5; the 2.5 us run is 1.33e-7 from this run's method at rtol 1e-10, and the 1.25 us run
-  // 2.8e-8, README "Every mode where no band meets rtol"): within it.
+  // 2.8e-8, docs/transient_measurements.md "Every mode where no band meets rtol"): within it.
   const TransientRun every = run_with(model, "auto", t_end, output_step, 1e-7);
   ASSERT_TRUE(every.result.ok) << every.result.message;
   ASSERT_EQ(every.result.phases.size(), 1u);
@@ -519,7 +519,7 @@ TEST(TransientBand, AQuasiStaticStiffJointIsSolvedWhereverTheSceneSits) {
        {std::array<double, 3>{0, 0, 0}, {0, 0.3, 0}, {100, 50, 0}}) {
     const Model model = scene_from_json(testing::stiff_joint_bob(pivot));
     const int bob = model.free_bodies.front();
-    for (const auto [rtol, atol] : {std::pair{1e-4, 1e-9}, std::pair{1e-6, 1e-8}}) {
+    for (const auto& [rtol, atol] : {std::pair{1e-4, 1e-9}, std::pair{1e-6, 1e-8}}) {
       TransientOptions o = options(1.0, 0.005, rtol, atol);
       o.integrator.method = IntegratorMethod::kModal;
       o.integrator.max_frequency_hz = 20.0;

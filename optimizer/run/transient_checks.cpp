@@ -34,6 +34,11 @@ const char kMultistepFindings[] =
     "damped tip on a cantilever: docs/transient_measurements.md \"Multistep runs verify "
     "themselves\")";
 
+// The reason of a verification by default ("verify": "auto"): why, and how to skip it.
+std::string by_default(const std::string& why) {
+  return "\"verify\": \"auto\", the default: " + why + "; \"verify\": false skips the rerun";
+}
+
 }  // namespace
 
 // Whether a rail reached its min_length in the run (its law has a kink there, at which the
@@ -96,13 +101,12 @@ std::string verification_reason(const AnalysisSpec& spec, const Model& model,
   }
   if (options.integrator.fixed_step > 0.0) return "";
   if (moves_as_mechanism(model))
-    return "\"verify\": \"auto\", the default: bodies move as a mechanism (not held by beams "
-           "and fixed joints to the ground), where error control was found far off without a "
-           "sign; \"verify\": false skips the rerun";
+    return by_default(
+        "bodies move as a mechanism (not held by beams and fixed joints to the ground), where "
+        "error control was found far off without a sign");
   if (multistep(options.integrator.method) && model.n_free() > 0)
-    return std::string("\"verify\": \"auto\", the default: ") +
-           method_name(options.integrator.method) + " integrates the run, " + kMultistepFindings +
-           "; \"verify\": false skips the rerun";
+    return by_default(std::string(method_name(options.integrator.method)) +
+                      " integrates the run, " + kMultistepFindings);
   return "";
 }
 
@@ -132,16 +136,14 @@ std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
   const auto phase = std::find_if(result.phases.begin(), result.phases.end(),
                                   [](const MethodPhase& p) { return multistep(p.method); });
   if (phase != result.phases.end() && model.n_free() > 0)
-    return "\"verify\": \"auto\", the default: auto handed the run to " + phase->method +
-           " at t = " + format_number(phase->t) + " s, " + kMultistepFindings +
-           "; \"verify\": false skips the rerun";
+    return by_default("auto handed the run to " + phase->method +
+                      " at t = " + format_number(phase->t) + " s, " + kMultistepFindings);
   if (std::none_of(result.phases.begin(), result.phases.end(),
                    [](const MethodPhase& p) { return p.relinearized; }))
     return "";
-  return "\"verify\": \"auto\", the default: the run relinearized as bodies turned (" +
-         std::to_string(result.phase_count) +
-         " phases): a large motion, where error control was found far off without a sign; "
-         "\"verify\": false skips the rerun";
+  return by_default("the run relinearized as bodies turned (" + std::to_string(result.phase_count) +
+                    " phases): a large motion, where error control was found far off without a "
+                    "sign");
 }
 
 // The distances in multiples of the tolerance: in the centres rtol x + atol, x the rerun's
@@ -175,11 +177,11 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
     // Verified by default, the user did not ask for it: say how to skip it (a sweep whose
     // designs fit max_seconds_per_design but whose reruns do not warned on every row; an
     // adversarial review of bdf's verification, 2026-11-30).
-    const bool by_default = v.reason.rfind("\"verify\": \"auto\"", 0) == 0;
+    const bool unasked = spec.verify == AnalysisSpec::Verify::kAuto;
     return "transient \"" + spec.name + "\": the verification rerun failed (" + v.message +
            "): the run's error is not measured" +
-           (by_default ? "; give it more max_seconds or max_steps, or \"verify\": false skips it"
-                       : "");
+           (unasked ? "; give it more max_seconds or max_steps, or \"verify\": false skips it"
+                    : "");
   }
   if (options.integrator.fixed_step > 0.0) return "";
   std::string what;

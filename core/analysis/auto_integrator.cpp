@@ -142,7 +142,11 @@ class AutoIntegrator : public Integrator {
   }
 
   int advance(double tout, double tstop, N_Vector y, double* t) override {
-    for (;;) {
+    for (bool switched = false;; switched = true) {
+      // A modal phase that failed after reaching the target (a band's quasi-static part at the
+      // state reached) hands over there: the implicit or explicit method starts with the next
+      // call (SUNDIALS refuses a stop time at its start).
+      if (switched && !modal_ && *t >= std::min(tout, tstop)) return 0;
       const int flag = current_->advance(tout, tstop, y, t);
       if (modal_ && (flag == kModalStepTooSmall || flag == kModalNonFinite) &&
           !context_->timed_out && !context_->interrupted && context_->callback_error.empty()) {

@@ -234,18 +234,18 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
           format("element forces (shear in very short segments) are uncertain by that much; the "
                  "displacements are converged (last correction %.2g of them)",
                  result.correction));
-    if (newton.singular > 0)
+    if (newton.reported_singular() > 0)
       result.warnings.push_back(
           newton.held
               ? "the tangent stiffness lost its stiffness in " + std::to_string(newton.singular) +
                     " direction(s) along the load path (a limit or bifurcation point of the "
                     "structure was passed); the equilibrium reached from it is reported"
-              : "the tangent stiffness has " + std::to_string(newton.singular) +
+              : "the tangent stiffness has " + std::to_string(newton.last_singular) +
                     " direction(s) without stiffness (a free mechanism); the equilibrium closest "
                     "to the initial configuration along them is reported");
     // What the beam law leaves out of the elements' own axial forces, measured on this
     // equilibrium (core/analysis/axial_force_check.hpp).
-    if (result.ok && newton.singular == 0) {
+    if (result.ok && newton.reported_singular() == 0) {
       const MissingAxialForces missing(model, data);
       std::string why;
       if (missing.any()) {

@@ -272,7 +272,12 @@ struct Newton {
   TangentSolver solver;
   const bool held = held_by_beams(model);  // every free body held by beams to a fixed body
   int iterations = 0;
-  int singular = 0;
+  int singular = 0;       // null directions: the most at any iterate
+  int last_singular = 0;  // null directions at the last iterate
+  // The null directions a result reports: for a structure held by beams those met along the
+  // load path (a limit or bifurcation point passed), for a mechanism those of its equilibrium
+  // (a pendulum's swing has none once its joint carries the bob, though the unloaded start had).
+  int reported_singular() const { return held ? singular : last_singular; }
   double residual = 0.0;
   double floor = 0.0;       // rounding floor at the last tangent
   double correction = 0.0;  // last correction / displacement
@@ -358,6 +363,8 @@ struct Newton {
     int rising = 0;
     int noisy = 0;             // iterations in a row with the residual near its rounding floor
     double noisy_first = 0.0;  // the correction at the first of them
+    double pushed = -1.0;      // what the last iterate's loads pushed along its null
+                               // directions (-1: they did not)
     for (int it = 0; it < max_iterations; ++it) {
       if (r <= target) {
         residual = r;
@@ -371,14 +378,28 @@ struct Newton {
       std::string why;
       if (!solver.factorize(model, data, &why)) return fail(why, false);
       singular = std::max(singular, solver.null_directions);
+      last_singular = solver.null_directions;
       Eigen::VectorXd dx = solver.solve(-w);
       if (!dx.allFinite()) return fail("the tangent stiffness is singular", false);
       // A minimum-norm solve that leaves more of the forces than 1e-6 of them, the rounding
       // floor and the solve's own rounding (a bob on a revolute joint at a cantilever's tip, c =
       // 1e-6: 6e-6 of the forces, a third of eps |S| |dx|) pushes along its null directions.
-      if (solver.null_directions > 0 && scaled_norm(solver.apply(dx) + w, length) >
-                                            std::max({1e-6 * scaled_norm(w, length), 10.0 * floor,
-                                                      10.0 * solver.solve_rounding(dx, length)})) {
+      const double left = solver.null_directions > 0
+                              ? scaled_norm(solver.apply(dx) + w, length)
+                              : 0.0;  // what the minimum-norm step leaves of the forces
+      const bool pushes = left > std::max({1e-6 * scaled_norm(w, length), 10.0 * floor,
+                                           10.0 * solver.solve_rounding(dx, length)});
+      // A mechanism's stiffness may come from the loads it carries: a pendulum released off the
+      // vertical from an unloaded joint has no stiffness in its swing until the joint carries
+      // the bob's weight, and gravity pushes along the swing. So a mechanism goes on with the
+      // minimum-norm step (it loads the joint) while what the loads push along its null
+      // directions falls (to a tenth at least per iterate: a 3 kg bob on a revolute joint
+      // tilted 5 degrees left 0.83 of its 29 N, then none; on a spherical joint 1.02, then
+      // 1.2e-4, then none), and fails when it does not (a carriage pushed along its rail pushes
+      // as much at the next iterate).
+      const bool going_on = pushes && !held && (pushed < 0.0 || left < 0.1 * pushed);
+      pushed = pushes ? left : -1.0;
+      if (pushes && !going_on) {
         // Every body held by beams: no mechanism, the tangent lost its stiffness under the
         // loads (buckling, a snap, an element at the end of its law's range); a smaller load
         // step may pass. Otherwise a free body or mechanism is pushed: no load step helps.

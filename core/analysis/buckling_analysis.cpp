@@ -334,9 +334,21 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
       factors.push_back(factor);
       stiffness.push_back(phi.dot(k0 * phi));
       result.modes.push_back({factor, normalized_shape(phi, length), nonlinearity});
-      if (nonlinearity > kBucklingNonlinearityLimit)
+      const std::string mode_number =
+          text("buckling mode %.0f: ", static_cast<double>(result.modes.size()));
+      if (nonlinearity >= kBucklingNotALoad)
         result.warnings.push_back(
-            text("buckling mode %.0f: ", static_cast<double>(result.modes.size())) +
+            mode_number +
+            text("the factor %.6g is no buckling load: on the prebuckling path at that factor ",
+                 factor) +
+            text("the shape keeps %.2g of its stiffness, which the linearization in the load "
+                 "loses (a beam bent by a load that compresses nothing gives such factors); a "
+                 "static analysis with the loads at the factor tells whether the structure "
+                 "buckles",
+                 nonlinearity));
+      else if (nonlinearity > kBucklingNonlinearityLimit)
+        result.warnings.push_back(
+            mode_number +
             text("the tangent stiffness changes with the prebuckling deformation beyond first "
                  "order: at the factor %.6g ",
                  factor) +

@@ -131,6 +131,50 @@ TEST(StaticExtremes, ShortBeamFarFromTheOriginKeepsItsPrecision) {
   EXPECT_NEAR(-r.u.y() / exact, 1.0, 1e-9);
 }
 
+// A 2 m cantilever of 32 segments (8 x 20 mm steel) turned arbitrarily and 10 m from the origin,
+// bent into an arc by a follower torque (M L / EI = 1.2): its end turns by M L / EI and lies on the
+// circle of radius EI / M, whatever its distance from the origin. Its residual stayed at 14 times
+// the rounding floor's estimate while the Newton corrections were 1e-14 of the displacement, and
+// the analysis failed as rounding-limited; converged in displacement near the floor, it now ends
+// there (static_newton.hpp). The same cantilever at the origin gives the same displacements.
+TEST(StaticExtremes, AnArcBentFarFromTheOriginConvergesAsAtTheOrigin) {
+  const auto solve_at = [](const Vec3& offset) {
+    const Vec3 p1 = Vec3(10.0, 0.0, 0.0) + offset;
+    const Vec3 p2 = Vec3(8.02248652895991, -0.07543576782407112, 0.28939577880088035) + offset;
+    const Vec3 p3 = Vec3(9.864803890942358, -0.18796833200735952, -0.9728257388957416) + offset;
+    Scene s;
+    s.material("st", 2e11, 8e10, 7800);
+    s.j["sections"]["c"] = {{"shape", "rectangle"}, {"width", 0.008}, {"height", 0.02}};
+    s.body("tip", 0.1, Vec3(1e-5, 1e-5, 1e-5), p2);
+    s.beam("b", "ground", "tip", p1, p2, "st", "c");
+    s.last_beam()["point3"] = testing::vec(p3.x(), p3.y(), p3.z());
+    s.last_beam()["segments"] = 32;
+    s.torque("tip", Vec3(6.542494638274142, -100.5005407699171, 18.509377862650844));
+    s.j["loads"].back()["follows"] = true;
+    return solve(s);
+  };
+  const Solved far = solve_at(Vec3::Zero());
+  ASSERT_TRUE(far.result.ok) << far.result.message;
+  const Solved near = solve_at(Vec3(-9.0, 0.0, 0.0));
+  ASSERT_TRUE(near.result.ok) << near.result.message;
+  const double length = 2.0, turn = 1.2;
+  const Vec3 axis = Vec3(-0.9887567355200451, -0.03771788391203556, 0.14469788940044018);
+  const Vec3 bend = Vec3(-0.13519610905764087, -0.18796833200735952, -0.9728257388957416);
+  const double along = far.u.dot(axis), across = far.u.dot(bend);
+  const double along_exact = length * std::sin(turn) / turn - length;
+  const double across_exact = length * (1 - std::cos(turn)) / turn;
+  std::printf(
+      "arc 10 m out: turn %.12f rad (M L / EI %.1f), along %.6f (%.6f), across %.6f "
+      "(%.6f) m; %d iterations; at 1 m: %.2e m apart\n",
+      far.rotation.norm(), turn, along, along_exact, across, across_exact, far.result.iterations,
+      (far.u - near.u).norm());
+  EXPECT_NEAR(far.rotation.norm(), turn, 1e-9);
+  // 32 segments: 1.8e-4 and 1.2e-4 of L from the circle (measured).
+  EXPECT_NEAR(along, along_exact, 5e-4 * length);
+  EXPECT_NEAR(across, across_exact, 5e-4 * length);
+  EXPECT_LT((far.u - near.u).norm(), 1e-9 * length);
+}
+
 // A load of 1e155 N turns the tip's element beyond the range of its law at any load step the
 // arithmetic can take: the analysis fails and says where, without calling the clamped cantilever a
 // mechanism. (It once reported "ok" with d = 0: the load's norm overflowed to infinity and so did

@@ -27,4 +27,18 @@ inline int body_index(const Model& model, const std::string& name) {
   return 0;
 }
 
+// Issue 17's stiff-hinge pendulum (tests/benchmarks/transient_auto/stiff_hinge_pendulum.json): a
+// 1 kg bob on a stiff hinge (a cylindrical rail: a 50 mm axle of 20 mm steel) swinging +-1.5 rad
+// under gravity.
+inline constexpr const char* kStiffHingePendulum = R"({
+    "gravity": [0, 0, -9.81],
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"axle": {"shape": "circle", "diameter": 0.02}},
+    "bodies": [{"name": "bob", "mass": 1.0, "inertia": [0.001, 0.001, 0.001],
+                "position": [0.05, 0, -0.5], "velocity": [0, 3.0, 0],
+                "angular_velocity": [6.0, 0, 0]}],
+    "rails": [{"name": "hinge", "type": "cylindrical", "body1": "ground", "body2": "bob",
+               "point1": [0, 0, 0], "point2": [0.05, 0, 0], "point3": [0, 1, 0],
+               "material": "steel", "section": "axle"}]})";
+
 }  // namespace beamrail::testing

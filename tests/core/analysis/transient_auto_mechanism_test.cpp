@@ -419,16 +419,7 @@ TEST(TransientAuto, ADampedGroundedMechanismRunsDirk) {
 // message blaming its input; it now goes on with dirk and keeps the band's warning (its dropped
 // inertia: 0.26 of the kinetic energy), which says the run is not to be trusted.
 TEST(TransientAuto, APhaseThatFailsAtItsOutputTimeHandsOverThere) {
-  const Model model = scene_from_json(R"({
-    "gravity": [0, 0, -9.81],
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
-    "sections": {"axle": {"shape": "circle", "diameter": 0.02}},
-    "bodies": [{"name": "bob", "mass": 1.0, "inertia": [0.001, 0.001, 0.001],
-                "position": [0.05, 0, -0.5], "velocity": [0, 3.0, 0],
-                "angular_velocity": [6.0, 0, 0]}],
-    "rails": [{"name": "hinge", "type": "cylindrical", "body1": "ground", "body2": "bob",
-               "point1": [0, 0, 0], "point2": [0.05, 0, 0], "point3": [0, 1, 0],
-               "material": "steel", "section": "axle"}]})");
+  const Model model = scene_from_json(testing::kStiffHingePendulum);
   const TransientRun run = run_with(model, "auto", 0.2, 0.01, 1e-6, 100.0);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   EXPECT_EQ(run.result.t_reached, 0.2);

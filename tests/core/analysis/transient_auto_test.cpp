@@ -58,23 +58,12 @@ TEST(TransientAuto, PointMassTipTakesTheModalMethod) {
   }
 }
 
-// A bob on a stiff hinge (a cylindrical rail: a 50 mm axle of 20 mm steel) swinging +-1.5 rad:
-// auto relinearizes the modal method each time the bob turns 0.02 rad from its linearization (a
-// 6-dof eigenproblem is cheap) and stays within its tolerance of a tight explicit run.
-const char* kStiffHingePendulum = R"({
-    "gravity": [0, 0, -9.81],
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
-    "sections": {"axle": {"shape": "circle", "diameter": 0.02}},
-    "bodies": [{"name": "bob", "mass": 1.0, "inertia": [0.001, 0.001, 0.001],
-                "position": [0.05, 0, -0.5], "velocity": [0, 3.0, 0],
-                "angular_velocity": [6.0, 0, 0]}],
-    "rails": [{"name": "hinge", "type": "cylindrical", "body1": "ground", "body2": "bob",
-               "point1": [0, 0, 0], "point2": [0.05, 0, 0], "point3": [0, 1, 0],
-               "material": "steel", "section": "axle"}]})";
-
+// Issue 17's stiff-hinge pendulum (tests/support/scenes.hpp): auto relinearizes the modal method
+// each time the bob turns 0.02 rad from its linearization (a 6-dof eigenproblem is cheap) and
+// stays within its tolerance of a tight explicit run.
 TEST(TransientAuto, StiffHingePendulumRelinearizes) {
   Diagnostics diag;
-  const auto json = parse_json(kStiffHingePendulum, "test", diag);
+  const auto json = parse_json(testing::kStiffHingePendulum, "test", diag);
   const std::optional<Model> model = load_scene(*json, {"test", ""}, diag);
   ASSERT_TRUE(model) << diag.format();  // (a plausibility warning: the bob hangs 0.5 m off)
   const double t_end = 0.3;

@@ -424,11 +424,11 @@ struct Newton {
       const double size = motion_size(x, length);
       correction = size > 0.0 ? motion_size(dx, length) / size : INFINITY;
       // At the rounding floor a correction this small is rounding noise: the last one is applied.
-      // So too near it (within 1e3) once three corrections in a row are that small: the floor
+      // So too near it (within 100 times) once three corrections in a row are that small: the floor
       // estimate can miss rounding by more than its factor 10 (a cantilever of 32 segments 10 m
       // from the origin, bent into an arc by a follower torque, stayed at 14 times it while its
       // corrections were 1e-14 of the displacement, and failed as rounding-limited).
-      settled = r <= 1e3 * floor && correction <= kCorrectionTolerance ? settled + 1 : 0;
+      settled = r <= 1e2 * floor && correction <= kCorrectionTolerance ? settled + 1 : 0;
       const bool converged =
           (r <= 10.0 * floor && correction <= kCorrectionTolerance) || settled >= 3;
       // At most kMaxRotationStep of rotation per body in one iterate.

@@ -50,10 +50,11 @@ RigidMotion rigid_motion(const Model& model, const double* y, const std::vector<
   RigidMotion out;
   double mass = 0.0;
   for (int i : part) {
-    const double m = model.bodies[model.free_bodies[i]].mass;
+    const Body& body = model.bodies[model.free_bodies[i]];
+    const double m = body.mass;
     const double* s = y + kS * i;
     mass += m;
-    out.centre += m * Vec3(s[0], s[1], s[2]);
+    out.centre += m * (body.position + Vec3(s[0], s[1], s[2]));
     out.velocity += m * Vec3(s[7], s[8], s[9]);
   }
   if (!(mass > 0.0)) return RigidMotion{};
@@ -65,7 +66,7 @@ RigidMotion rigid_motion(const Model& model, const double* y, const std::vector<
     const Body& body = model.bodies[model.free_bodies[i]];
     const double* s = y + kS * i;
     const Mat3 a = rotation_matrix<double>(Vec4(s[3], s[4], s[5], s[6]));
-    const Vec3 r = Vec3(s[0], s[1], s[2]) - out.centre;
+    const Vec3 r = body.position + Vec3(s[0], s[1], s[2]) - out.centre;
     const Mat3 own = a * body.inertia * a.transpose();
     inertia += own - body.mass * skew<double>(r) * skew<double>(r);
     momentum += body.mass * r.cross(Vec3(s[7], s[8], s[9]) - out.velocity) +
@@ -81,7 +82,9 @@ RigidMotion rigid_motion(const Model& model, const double* y, const std::vector<
   return out;
 }
 
-void ModalCoordinates::set_reference(const double* states, int bodies) {
+void ModalCoordinates::set_reference(const Model& model, const double* states) {
+  const int bodies = model.n_free();
+  position_.resize(bodies);
   c0_.resize(bodies);
   q0_.resize(bodies);
   a0_.resize(bodies);
@@ -90,6 +93,7 @@ void ModalCoordinates::set_reference(const double* states, int bodies) {
   frame_of_.assign(bodies, -1);
   for (int b = 0; b < bodies; ++b) {
     const double* r = states + kS * b;
+    position_[b] = model.bodies[model.free_bodies[b]].position;
     c0_[b] = Vec3(r[0], r[1], r[2]);
     q0_[b] = Vec4(r[3], r[4], r[5], r[6]).normalized();
     a0_[b] = rotation_matrix<double>(q0_[b]);
@@ -131,8 +135,8 @@ void ModalCoordinates::offsets(double t, const double* y, ModeBlock& x) const {
       // In the frame: p = R^T (c - s), v = R^T (v - V) - W x p, A = R^T A, w = R^T w - W.
       const Frame& f = frames[frame_of_[b]];
       const Mat3 rt = f.rotation.transpose();
-      const Vec3 p = rt * (c - f.s0 - f.velocity * (t - f.t0));
-      c = f.s0 + p;
+      const Vec3 p = rt * (position_[b] + c - f.s0 - f.velocity * (t - f.t0));
+      c = f.s0 + p - position_[b];
       v = rt * (v - f.velocity) - f.omega.cross(p);
       a = rt * a;
       w = rt * w - f.omega;
@@ -164,8 +168,8 @@ bool ModalCoordinates::states(double t, const ModeBlock& x, double* y, double ma
     if (frame_of_[b] >= 0) {
       // Back to fixed axes: c = s + R p, v = V + R (W x p + v), A = R A, body axes w + A^T W.
       const Frame& f = frames_[frame_of_[b]];
-      const Vec3 p = c - f.s0;
-      c = f.s0 + f.velocity * (t - f.t0) + f.rotation * p;
+      const Vec3 p = position_[b] + c - f.s0;
+      c = f.s0 + f.velocity * (t - f.t0) + f.rotation * p - position_[b];
       v = f.velocity + f.rotation * (f.omega.cross(p) + v);
       w += f.omega;
       q = quat_multiply(f.q, q);
@@ -196,7 +200,7 @@ bool ModalCoordinates::accelerations(const ModeBlock& x, const double* ydot,
       // d2p/dt2 = R^T d2c/dt2 - 2 W x dp/dt - W x (W x p); the frame's angular acceleration
       // A (d omega_body / dt) + w x W, w the angular velocity in the frame.
       const Frame& f = frames_[frame_of_[b]];
-      const Vec3 p = c0_[b] + x.block<3, 1>(kD * b, 0) - f.s0;
+      const Vec3 p = position_[b] + c0_[b] + x.block<3, 1>(kD * b, 0) - f.s0;
       const Vec3 v = x.block<3, 1>(kD * b, 1);
       acceleration = f.rotation.transpose() * acceleration - 2.0 * f.omega.cross(v) -
                      f.omega.cross(f.omega.cross(p));

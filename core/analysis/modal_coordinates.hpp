@@ -45,9 +45,9 @@ RigidMotion rigid_motion(const Model& model, const double* y, const std::vector<
 
 class ModalCoordinates {
  public:
-  // The reference configuration: the centres and orientations of the 13 states of `bodies`
-  // free bodies.
-  void set_reference(const double* states, int bodies);
+  // The reference configuration: the centres (displacements from the bodies' initial positions)
+  // and orientations of the 13 states of the model's free bodies.
+  void set_reference(const Model& model, const double* states);
   int bodies() const { return static_cast<int>(c0_.size()); }
 
   // The reference of the bodies `part` (state order) turns with `motion` from t0 on (see above);
@@ -77,7 +77,8 @@ class ModalCoordinates {
   // The largest rotation of a body from the reference at x [rad].
   double largest_rotation(const ModeBlock& x) const;
 
-  // The error weight of offset j (0..5) of body b at x: rtol |c| + atol for the centre, rtol +
+  // The error weight of offset j (0..5) of body b at x: rtol |u| + atol for the centre (u its
+  // displacement from the initial position, as the other methods weight their states), rtol +
   // atol for the rotation vector.
   double offset_weight(int b, int j, const ModeBlock& x, double rtol, double atol) const {
     return j < 3 ? rtol * std::abs(c0_[b](j) + x(kDofsPerBody * b + j, 0)) + atol : rtol + atol;
@@ -93,7 +94,8 @@ class ModalCoordinates {
     void at(double t);                 // sets q and rotation to R(t)
   };
 
-  std::vector<Vec3> c0_;
+  std::vector<Vec3> position_;  // the bodies' initial centres (Body::position)
+  std::vector<Vec3> c0_;        // the reference centres' displacements from position_
   std::vector<Vec4> q0_;
   std::vector<Mat3> a0_;
   std::vector<Mat3> orientation_;  // the rotation matrices (in the frame) states() last wrote

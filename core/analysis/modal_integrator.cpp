@@ -85,7 +85,7 @@ class ModalExponential : public Integrator {
     set_state(model, data, reference.data());
     compute_wrenches(model, data, c.force_time(t0));
     compute_tangent(model, data, c.force_time(t0), false);
-    coordinates_.set_reference(reference.data(), model.n_free());
+    coordinates_.set_reference(model, reference.data());
     // A part of the scene that floats and spins: its reference turns with it
     // (modal_coordinates.hpp), when it turns more than kTurningFrameMinTurn by the end of the run
     // (1 s when the run gives no end): a part that barely turns, or not at all (an angular

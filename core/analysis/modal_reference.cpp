@@ -79,8 +79,7 @@ bool modal_reference(const Model& model, const IntegratorOptions& options, OdeCo
   for (int b = 0; b < model.n_free(); ++b) {
     const int body = model.free_bodies[b];
     double* r = reference.data() + kStatesPerBody * b;
-    const Vec3 c = centre(model, data, body);
-    for (int j = 0; j < 3; ++j) r[j] = c(j);
+    for (int j = 0; j < 3; ++j) r[j] = data.pose[body].u(j);
     for (int j = 0; j < 4; ++j) r[3 + j] = data.q[body](j);
     for (int j = 7; j < kStatesPerBody; ++j) r[j] = 0.0;
   }

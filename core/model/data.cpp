@@ -30,7 +30,7 @@ void set_state(const Model& model, Data& data, const double* y) {
     const int i = model.free_bodies[k];
     const double* s = y + kStatesPerBody * k;
     Pose<double>& p = data.pose[i];
-    p.u = Vec3(s[0], s[1], s[2]) - model.bodies[i].position;
+    p.u = Vec3(s[0], s[1], s[2]);
     data.q[i] = Vec4(s[3], s[4], s[5], s[6]);
     p.A = rotation_matrix<double>(data.q[i]);
     p.v = Vec3(s[7], s[8], s[9]);
@@ -61,7 +61,7 @@ void initial_state(const Model& model, double* y) {
     double* s = y + kStatesPerBody * k;
     const Vec4 q = b.orientation / b.orientation.norm();
     for (int j = 0; j < 3; ++j) {
-      s[j] = b.position(j);
+      s[j] = 0.0;
       s[7 + j] = b.velocity(j);
       s[10 + j] = b.angular_velocity(j);
     }
@@ -74,9 +74,8 @@ void initial_state_at(const Model& model, const Data& configuration, double* y) 
   for (int k = 0; k < model.n_free(); ++k) {
     const int i = model.free_bodies[k];
     double* s = y + kStatesPerBody * k;
-    const Vec3 c = centre(model, configuration, i);
     const Vec4 q = configuration.q[i] / configuration.q[i].norm();
-    for (int j = 0; j < 3; ++j) s[j] = c(j);
+    for (int j = 0; j < 3; ++j) s[j] = configuration.pose[i].u(j);
     for (int j = 0; j < 4; ++j) s[3 + j] = q(j);
   }
 }

@@ -41,7 +41,8 @@ inline Vec3 centre(const Model& model, const Data& data, int i) {
   return model.bodies[i].position + data.pose[i].u;
 }
 
-// Sets pose, q and w of the free bodies from a state vector y (dim model.n_states).
+// Sets pose, q and w of the free bodies from a state vector y (dim model.n_states; its centres
+// are displacements u from the bodies' initial positions, core/model/dynamics.hpp).
 void set_state(const Model& model, Data& data, const double* y);
 
 // Sets pose, q and w of the driven bodies (model.driven_bodies) at time t [s] from their

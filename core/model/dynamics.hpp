@@ -1,6 +1,7 @@
 // Rigid-body equations of motion of the free bodies (docs/model.md) as a first-order system
-// dy/dt = f(t, y) with 13 states per free body, y_k = (c, q, v, w):
-//   dc/dt = v,  dq/dt = 1/2 q (x) (0, w),  m dv/dt = F,  J dw/dt = A^T M - w x (J w),
+// dy/dt = f(t, y) with 13 states per free body, y_k = (u, q, v, w), u = c - position the
+// displacement of the centre from the body's initial one (docs/model.md "Bodies"):
+//   du/dt = v,  dq/dt = 1/2 q (x) (0, w),  m dv/dt = F,  J dw/dt = A^T M - w x (J w),
 // and its exact Jacobian df/dy, assembled per 13 x 13 block from the element tangents.
 #pragma once
 

@@ -187,7 +187,7 @@ struct ModelT {
 
   std::vector<int> free_bodies;    // body index of each free body, in state order
   std::vector<int> driven_bodies;  // body index of each driven body
-  int n_states = 0;                // 13 per free body: c(3), q(4), v(3), w(3)
+  int n_states = 0;                // 13 per free body: u(3), q(4), v(3), w(3)
   int n_dofs = 0;                  // 6 per free body: dc(3), dtheta(3)
   BlockPattern pattern;
 

@@ -197,7 +197,8 @@ TEST_F(SpeedAccuracyRuns, VerifyEstimatesTheErrorOfARunMeasuredAgainstATightRefe
   EXPECT_DOUBLE_EQ(v["rtol"].get<double>(), 1e-5);
   EXPECT_DOUBLE_EQ(v["atol"].get<double>(), 1e-9);
   EXPECT_FALSE(v.contains("fixed_step"));
-  EXPECT_GT(v["steps"].get<long>(), summary["analyses"][0]["steps"].get<long>());
+  // The explicit table's steps are bound by its stability here, not by rtol (457 at 1e-4, 453 at
+  // 1e-5), so the rerun is another path, not a longer one: the estimate below is what tells.
   const double estimate = v["error"];
   std::printf("erk rtol 1e-4: error %.4g against rtol 1e-11, %.4g against rtol 1e-5 (ratio %.3f)\n",
               measured, estimate, estimate / measured);

@@ -181,9 +181,14 @@ TEST(PrescribedMotion, ShakenBaseMovesTheMassAsTheClosedForm) {
     }
   EXPECT_LT(errors[1], 1e-7 * amplitude);
   EXPECT_GT(errors[0] / errors[1], 10.0);
-  // auto: as accurate as bdf at the same tolerance, in fewer steps (an A-stable DIRK).
-  EXPECT_LT(errors[2], errors[0]);
-  EXPECT_LT(steps[2], steps[0]);
+  // auto: about as accurate as bdf at the same tolerance, in a quarter of the steps (an A-stable
+  // DIRK). Both hold the mass's displacement to rtol of itself since the states hold
+  // displacements (docs/model.md "Bodies"; before, to rtol of its 1 m distance from the origin):
+  // at rtol 1e-10 dirk 3.2e-10 m (5.1e-10 before) in 948 steps, bdf 1.8e-10 m (9.8e-10 before)
+  // in 3,964; from rtol 1e-8 to 1e-12 dirk's errors are 1.3 to 0.53 times bdf's, each falling
+  // with rtol.
+  EXPECT_LT(errors[2], 2.0 * errors[0]);
+  EXPECT_LT(3 * steps[2], steps[0]);
   TransientOptions o = options(0.02, 2e-4, 1e-6, 1e-10);
   o.integrator.method = IntegratorMethod::kModal;
   const TransientRun modal = simulate(model, o);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/analysis/modal_coordinates.hpp"
+#include "core/model/data.hpp"
 #include "core/model/rotation.hpp"
 #include "tests/support/transient_run.hpp"
 
@@ -56,16 +57,7 @@ TransientRun run(const Model& model, IntegratorMethod method, double t_end, doub
 TEST(TurningFrame, CoordinatesGoBothWaysAndARigidTurnWithTheFrameIsNoOffset) {
   const Model model = scene_from_json(pair("[0.1, 0.1, 8]", "[0.05, 0.1, 8]", "1.2"));
   std::vector<double> y0(model.n_states);
-  for (int i = 0; i < model.n_free(); ++i) {
-    const Body& b = model.bodies[model.free_bodies[i]];
-    double* s = y0.data() + kStatesPerBody * i;
-    for (int j = 0; j < 3; ++j) {
-      s[j] = b.position(j);
-      s[7 + j] = b.velocity(j);
-      s[10 + j] = b.angular_velocity(j);
-    }
-    for (int j = 0; j < 4; ++j) s[3 + j] = b.orientation(j);
-  }
+  initial_state(model, y0.data());  // centres as displacements: zero
   const std::vector<std::vector<int>> parts = floating_parts(model);
   ASSERT_EQ(parts, (std::vector<std::vector<int>>{{0, 1}}));
   const RigidMotion motion = rigid_motion(model, y0.data(), parts.front());
@@ -75,7 +67,7 @@ TEST(TurningFrame, CoordinatesGoBothWaysAndARigidTurnWithTheFrameIsNoOffset) {
   EXPECT_NEAR(motion.angular_velocity.z(), 8.0, 0.1);
 
   ModalCoordinates frame;
-  frame.set_reference(y0.data(), model.n_free());
+  frame.set_reference(model, y0.data());
   frame.set_turning_frame(0.5, motion, parts.front());
   ModeBlock x(12, 2);
   for (int i = 0; i < 12; ++i) {
@@ -97,7 +89,9 @@ TEST(TurningFrame, CoordinatesGoBothWaysAndARigidTurnWithTheFrameIsNoOffset) {
   std::vector<double> turned = y0;
   for (int i = 0; i < model.n_free(); ++i) {
     double* s = turned.data() + kStatesPerBody * i;
+    const Vec3 position = model.bodies[model.free_bodies[i]].position;
     const Vec3 p =
+        position +
         Vec3(y0[kStatesPerBody * i], y0[kStatesPerBody * i + 1], y0[kStatesPerBody * i + 2]) -
         motion.centre;
     const Vec3 c = motion.centre + motion.velocity * dt + r * p;
@@ -106,7 +100,7 @@ TEST(TurningFrame, CoordinatesGoBothWaysAndARigidTurnWithTheFrameIsNoOffset) {
     const Mat3 a = rotation_matrix<double>(q);
     const Vec3 body_w = a.transpose() * w;
     for (int j = 0; j < 3; ++j) {
-      s[j] = c(j);
+      s[j] = c(j) - position(j);
       s[7 + j] = v(j);
       s[10 + j] = body_w(j);
     }

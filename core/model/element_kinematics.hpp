@@ -174,7 +174,7 @@ ElementFrames<T> element_frames(const ElementEndsT<P>& ends, const Pose<T>& b1, 
   // origin to points far from it cancel against the reference centres' offset (exactly, as the
   // body does not turn), so the chord keeps the displacements' precision wherever the element
   // sits (lever1 - R1 rounded them to eps |p2 - c1|: a cantilever on the ground 300 m from the
-  // origin took 3,500 times bdf's steps at the origin, its stiff rotary mode's forces noisy).
+  // origin took 3,400 times bdf's steps at the origin, its stiff rotary mode's forces noisy).
   f.xi = f.E1.transpose() * ((ends.centre_offset.template cast<T>() - f.R1 + f.R2) + (b2.u - b1.u));
   f.a = f.E1.transpose() * e2;
   relative_rotation(f.a, measure, f.phi, f.t);

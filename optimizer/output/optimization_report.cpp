@@ -370,10 +370,16 @@ OptimizationReport report_optimization(const OptimizationProblem& problem,
       s["best"] = b;
       s["responses"] = resp;
       Json scene = evaluator.document(best->x);
+      // Every design kept the study scene's "auto" segment counts: so does its re-run.
+      const std::string counts = write_segment_counts(scene, study_.model.segment_choices);
       scene["name"] = study_.name + "_best";
       scene["description"] = "The best design found by " + plan_.algorithm + " for study \"" +
                              study_.name + "\" (start " + std::to_string(best->start) +
-                             ", evaluation " + std::to_string(best->evaluation) + ").";
+                             ", evaluation " + std::to_string(best->evaluation) + ")." +
+                             (counts.empty() ? ""
+                                             : " Its segments are the counts \"auto\" chose for "
+                                               "the study's scene, which every design kept: " +
+                                                   counts + ".");
       ok =
           write_file_atomically(settings_.output / "best.json", b.dump(2) + "\n", &error) &&
           write_file_atomically(settings_.output / "best_scene.json", scene.dump(2) + "\n", &error);

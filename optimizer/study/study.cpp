@@ -28,6 +28,36 @@ std::string table_file(const AnalysisSpec& analysis, const std::string& table) {
   return analysis.name == type_name(analysis.type) ? table : analysis.name + "." + table;
 }
 
+std::string write_segment_counts(Json& document, const std::vector<SegmentChoice>& choices) {
+  std::string written;
+  const auto scene = document.find("scene");
+  if (scene == document.end() || !scene->is_object()) return written;
+  bool auto_left = false;
+  for (const char* list : {"beams", "rails"}) {
+    const auto entries = scene->find(list);
+    if (entries == scene->end() || !entries->is_array()) continue;
+    for (Json& e : *entries) {
+      const auto segments = e.find("segments");
+      if (segments == e.end() || !segments->is_string() || *segments != "auto") continue;
+      const auto name = e.find("name");
+      const auto choice =
+          name == e.end() || !name->is_string()
+              ? choices.end()
+              : std::find_if(choices.begin(), choices.end(),
+                             [&](const SegmentChoice& c) { return c.beam == *name; });
+      if (choice == choices.end()) {
+        auto_left = true;
+        continue;
+      }
+      *segments = choice->segments;
+      written += (written.empty() ? "" : ", ") + choice->beam + " " +
+                 std::to_string(choice->segments);
+    }
+  }
+  if (!written.empty() && !auto_left) scene->erase("segmentation");
+  return written;
+}
+
 int find_analysis(const Study& study, AnalysisSpec::Type type) {
   for (size_t i = 0; i < study.analyses.size(); ++i)
     if (study.analyses[i].type == type) return static_cast<int>(i);

@@ -139,6 +139,13 @@ std::optional<Study> load_study(const Json& document, const std::string& file,
 std::optional<Study> rebuild_scene(const Study& base, const Json& document, Diagnostics& diag,
                                    bool* full_read_needed);
 
+// The study document `document` with every "segments": "auto" of its scene's beams and rails
+// replaced by the count in `choices` (the counts a design keeps: the study scene's), and the
+// scene's "segmentation" removed once no "auto" is left: a design's document that `beamrail run`
+// reproduces (a re-run of "auto" chooses for that design's own members, not the study scene's).
+// The beams so written, with their counts ("column_left 14, beam 20"), or "" when none.
+std::string write_segment_counts(Json& document, const std::vector<SegmentChoice>& choices);
+
 // The index of the first analysis of the given type, or -1.
 int find_analysis(const Study& study, AnalysisSpec::Type type);
 

@@ -240,6 +240,19 @@ TEST(DesignReuse, AutoSegmentCountsAreTheStudysForEveryDesign) {
   EXPECT_EQ(alone->model.segment_choices[0].frequencies_checked, 3);
   EXPECT_GT(alone->model.segment_choices[0].segments, own.segments);
   EXPECT_FALSE(alone->model.segment_choices[0].pinned);
+
+  // The design's document with the counts written in (what best_scene.json holds) reads as the
+  // design the evaluator built: the study's count, no "auto" left and no segmentation target.
+  Json document = evaluator.document(longer);
+  EXPECT_EQ(write_segment_counts(document, study->model.segment_choices),
+            "arm " + std::to_string(own.segments));
+  EXPECT_EQ(document["scene"]["beams"][0]["segments"], own.segments);
+  EXPECT_FALSE(document["scene"].contains("segmentation"));
+  const auto written = load_study(document, "reuse.json", ".", diag);
+  ASSERT_TRUE(written) << diag.format();
+  EXPECT_TRUE(written->model.segment_choices.empty());
+  EXPECT_EQ(written->model.beams.size(), design->model.beams.size());
+  EXPECT_TRUE(written->input_warnings.empty());
 }
 
 }  // namespace

@@ -234,6 +234,7 @@ bool refuse_options(std::string* error, const std::string& message) {
 
 bool BucklingOptions::IsValid(std::string* error) const {
   if (modes < 1) return refuse_options(error, "modes must be at least 1");
+  if (guard_modes < 0) return refuse_options(error, "guard_modes must be at least 0");
   if (std::isnan(time)) return refuse_options(error, "time must be a number");
   if (!(max_seconds >= 0.0 && std::isfinite(max_seconds)))
     return refuse_options(error, "max_seconds must be 0 (no budget) or positive and finite");
@@ -296,7 +297,7 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
     } else {
       CholeskyOp bop(llt, n);
       ProductOp aop(minus_k1, deadline);
-      const Eigen::Index nev = std::min<Eigen::Index>(n - 1, wanted);
+      const Eigen::Index nev = std::min<Eigen::Index>(n - 1, wanted + options.guard_modes);
       const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
       Spectra::SymGEigsSolver<ProductOp, CholeskyOp, Spectra::GEigsMode::Cholesky> eigs(aop, bop,
                                                                                         nev, ncv);
@@ -317,9 +318,15 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
       if (mu(i) > floor) order.push_back(i);
     std::sort(order.begin(), order.end(),
               [&](Eigen::Index a, Eigen::Index b) { return mu(a) > mu(b); });
+    // (Lanczos's count as without the guard: the factors it would have computed.)
     result.positive_factors = static_cast<int>(order.size());
+    if (!dense) result.positive_factors = std::min(result.positive_factors, wanted);
     for (Eigen::Index i : order) {
-      if (static_cast<int>(result.modes.size()) >= wanted) break;
+      if (static_cast<int>(result.modes.size()) >= wanted) {
+        if (static_cast<int>(result.guard.size()) >= options.guard_modes) break;
+        result.guard.push_back({1.0 / mu(i), normalized_shape(vectors.col(i), length), 0.0});
+        continue;
+      }
       const double factor = 1.0 / mu(i);
       // How far the stiffness along the shape is from zero on the prebuckling path at the factor
       // (core/analysis/buckling_path.hpp): what the linearization in the load leaves out.

@@ -48,6 +48,10 @@ struct BucklingOptions {
                                                           // buckling_dense_is_faster
   double time = std::numeric_limits<double>::infinity();  // loads' time
   double max_seconds = 0.0;  // wall-clock budget [s]; 0: none (result.timed_out when spent)
+  // Positive factors computed beyond `modes` into BucklingResult::guard (design sensitivities, as
+  // ModalOptions::guard_modes); Lanczos then computes more pairs, which moves the factors' last
+  // digits.
+  int guard_modes = 0;
   // Whether the options can run: true, or false with the first problem in *error. The analysis
   // refuses options that are not valid; the study reader reports them.
   bool IsValid(std::string* error) const;
@@ -80,6 +84,9 @@ struct BucklingResult {
   std::string message;
   std::string solver;               // "dense" or "lanczos"
   std::vector<BucklingMode> modes;  // the lowest positive factors, ascending
+  // The positive factors above them that BucklingOptions::guard_modes asked for (fewer where there
+  // are no more), their nonlinearity not measured and no warning of their own.
+  std::vector<BucklingMode> guard;
   // Positive factors found in all: fewer than asked for when the scaled loads compress too little
   // of the structure (a structure in tension does not buckle); the missing factors are infinite.
   int positive_factors = 0;

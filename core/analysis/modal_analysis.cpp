@@ -463,6 +463,7 @@ std::string hz_text(double hz) {
 
 bool ModalOptions::IsValid(std::string* error) const {
   if (modes < 1) return refuse_options(error, "modes must be at least 1");
+  if (guard_modes < 0) return refuse_options(error, "guard_modes must be at least 0");
   if (std::isnan(time)) return refuse_options(error, "time must be a number");
   if (!std::isfinite(load_factor)) return refuse_options(error, "load_factor must be finite");
   if (!(max_seconds >= 0.0 && std::isfinite(max_seconds)))
@@ -489,7 +490,7 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
     const SparseMatrix sym = symmetric_stiffness(
         model, data, Eigen::VectorXd(m.diagonal()).cwiseSqrt().cwiseInverse(), &result.asymmetry);
     budget.check();
-    const int wanted = std::max(1, options.modes);
+    const int wanted = std::max(1, options.modes), guard = options.guard_modes;
     const Eigen::Index n = model.n_dofs;
     result.shift = choose_shift(model, sym, m);
     // Torques of fixed direction and follower loads make the loaded state non-conservative and K
@@ -522,7 +523,7 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
                        : !solve_dense(sym, m, result.shift, pairs))
         throw std::runtime_error("the dense eigensolver failed");
       budget.check();
-      found = classify(pairs, m, deformation, result.shift, wanted, result);
+      found = classify(pairs, m, deformation, result.shift, wanted + guard, result);
       result.solver = "dense";
     } else {
       // The topology's fill-reducing ordering of K + mu M (K's pattern), made by the first
@@ -533,7 +534,7 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
       // Rigid modes take places among the pairs nearest the shift: ask for more until enough
       // non-rigid ones are among them or every pair is.
       for (Eigen::Index extra = first_extra;; extra = std::max<Eigen::Index>(12, 4 * extra)) {
-        const Eigen::Index count = std::min<Eigen::Index>(n - 1, wanted + extra);
+        const Eigen::Index count = std::min<Eigen::Index>(n - 1, wanted + guard + extra);
         Eigenpairs pairs;
         if (nonsymmetric
                 ? !solve_nonsymmetric(k, m, result.shift, count, false, budget, pairs,
@@ -542,8 +543,8 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
           throw std::runtime_error(nonsymmetric
                                        ? "the shift-invert eigensolver (Arnoldi) did not converge"
                                        : "the shift-invert eigensolver did not converge");
-        found = classify(pairs, m, deformation, result.shift, wanted, result);
-        if (found >= wanted || count >= n - 1 || complex_pairs > 0) break;
+        found = classify(pairs, m, deformation, result.shift, wanted + guard, result);
+        if (found >= wanted + guard || count >= n - 1 || complex_pairs > 0) break;
       }
       result.solver = "shift-invert";
     }
@@ -556,6 +557,15 @@ ModalResult solve_modal(const Model& model, const ModalOptions& options, Data& d
           " pair(s) of complex eigenvalues (|Im w^2| / |w^2| up to " + growth_text +
           "), vibrations that grow: the loads without a potential (torques of fixed direction, "
           "follower loads) feed them energy");
+    }
+    // The guard's modes leave the result's before anything reads them.
+    {
+      std::vector<Mode> kept;
+      int elastic = 0;
+      for (Mode& mode : result.modes)
+        (mode.kind != Mode::Kind::kRigid && ++elastic > wanted ? result.guard : kept)
+            .push_back(std::move(mode));
+      result.modes = std::move(kept);
     }
     result.ok = true;
     participations(model, data, m, result);

@@ -59,6 +59,11 @@ struct ModalOptions {
   double load_factor = 1.0;  // 0: linearize the unloaded structure (no load stiffness)
   double max_seconds = 0.0;  // wall-clock budget [s]; 0: none (result.timed_out when spent)
   bool keep_mass = false;    // keep M in the result (to compare shapes)
+  // Elastic modes computed beyond `modes` into ModalResult::guard (design sensitivities: a mode
+  // repeated with the next one needs that one's shape, core/analysis/sensitivity.hpp). They take
+  // no part in the result's modes, checks or warnings; shift-invert then computes more pairs, which
+  // moves the modes' last digits.
+  int guard_modes = 0;
   // Whether the options can run: true, or false with the first problem in *error. The analysis
   // refuses options that are not valid; the study reader reports them.
   bool IsValid(std::string* error) const;
@@ -93,6 +98,9 @@ struct ModalResult {
   std::string message;
   std::string solver;       // "dense" or "shift-invert"
   std::vector<Mode> modes;  // ascending eigenvalue; rigid-body modes included, marked
+  // The elastic modes above them that ModalOptions::guard_modes asked for (fewer where the scene
+  // has no more), unchecked.
+  std::vector<Mode> guard;
   int rigid_modes = 0;
   double shift = 0.0;         // mu of the inverse problem [1/s^2]
   double asymmetry = 0.0;     // |K - K^T| / |K| of D K D, D = diag(M)^-1/2

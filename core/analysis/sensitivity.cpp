@@ -4,6 +4,8 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <stdexcept>
 
 #include "core/model/forces.hpp"
@@ -172,7 +174,7 @@ namespace {
 // cluster: pencil(first, last, mean) gives (A, B) over the cluster's modes, whose eigenvalues
 // A x = d B x are the derivatives (B = I for M-normalized modes).
 EigenvalueDerivatives cluster_derivatives(
-    const std::vector<double>& values,
+    const std::vector<double>& values, bool complete,
     const std::function<std::pair<Eigen::MatrixXd, Eigen::MatrixXd>(int, int, double)>& pencil) {
   const int n = static_cast<int>(values.size());
   EigenvalueDerivatives out;
@@ -186,6 +188,12 @@ EigenvalueDerivatives cluster_derivatives(
     int last = first;
     while (last + 1 < n && close(last, last + 1, kClusterGap)) ++last;
     const int size = last - first + 1;
+    if (last == n - 1 && !complete) {
+      // The values beyond the last may belong to this cluster: its derivatives are unknown.
+      for (int i = first; i <= last; ++i)
+        out.values[i] = std::numeric_limits<double>::quiet_NaN(), out.crossing[i] = 4;
+      break;
+    }
     double mean = 0.0;
     for (int i = first; i <= last; ++i) mean += values[i] / size;
     const auto [a, b] = pencil(first, last, mean);
@@ -223,7 +231,7 @@ EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data
                                              const DesignStep& step, const Eigen::VectorXd& v,
                                              double t, double load_factor,
                                              const std::vector<double>& lambdas,
-                                             const Eigen::MatrixXd& shapes) {
+                                             const Eigen::MatrixXd& shapes, bool complete) {
   // d/dp (K phi) and d/dp (M phi) along the design direction (through du/dp too), exact: the
   // e1 e2 part of the generalized forces seeded with phi, and the e2 part of M phi.
   if (!step.direction) throw std::invalid_argument("eigenvalue_derivatives: no design direction");
@@ -248,7 +256,7 @@ EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data
       }
     }
   }
-  return cluster_derivatives(lambdas, [&](int first, int last, double mean) {
+  return cluster_derivatives(lambdas, complete, [&](int first, int last, double mean) {
     const int size = last - first + 1;
     const auto phi = shapes.middleCols(first, size);
     const Eigen::MatrixXd a = phi.transpose() * dk_phi.middleCols(first, size) -
@@ -262,7 +270,7 @@ EigenvalueDerivatives buckling_factor_derivatives(const Model& reference, const 
                                                   const DualModel& scaled_direction,
                                                   const Eigen::VectorXd& v, double t,
                                                   const std::vector<double>& factors,
-                                                  const Eigen::MatrixXd& shapes) {
+                                                  const Eigen::MatrixXd& shapes, bool complete) {
   using H = HyperDual;
   const int n = reference.n_dofs;
   const Eigen::VectorXd none;
@@ -325,7 +333,7 @@ EigenvalueDerivatives buckling_factor_derivatives(const Model& reference, const 
     }
   }
   // (K0 + lambda K1) phi = 0: phi^T (dK0 + lambda dK1) phi + dlambda phi^T K1 phi = 0.
-  return cluster_derivatives(factors, [&](int first, int last, double mean) {
+  return cluster_derivatives(factors, complete, [&](int first, int last, double mean) {
     const int size = last - first + 1;
     const auto phi = shapes.middleCols(first, size);
     const Eigen::MatrixXd a = -(phi.transpose() * dk0_phi.middleCols(first, size) +

@@ -113,21 +113,33 @@ struct EigenvalueDerivatives {
   std::vector<double> values;  // dlambda/dp per eigenvalue given
   // Per eigenvalue: 0 alone, 1 near a crossing (within kNearCrossing of another), 2 in a cluster
   // (within kClusterGap) that splits as p grows (the directional derivative as p grows), 3 in a
-  // cluster that stays repeated (its members' derivatives are equal).
+  // cluster that stays repeated (its members' derivatives are equal), 4 in the last cluster of an
+  // incomplete list, which may go on beyond it (the value NaN: unknown).
   std::vector<int> crossing;
 };
 
-// The derivatives of the eigenvalues `lambdas` (ascending: every one computed, so that clusters
-// are found) of K phi = lambda M phi with M-normalized `shapes` (columns) about `base` (data of
-// base_model), K the symmetric part of -dW/du at time t and load_factor (the tangent the modal
-// analysis uses).
+// The modes a modal or buckling analysis computes beyond those asked for when its derivatives are
+// wanted (ModalOptions::guard_modes, BucklingOptions::guard_modes): the derivative of a mode
+// repeated with the next one needs that one's shape. A square column asked for 4 frequencies
+// (mode 4 equal to mode 5) got df4/dwidth 261.4 where it is 227.3 as the width grows and 1,108.9
+// as it shrinks, without a warning, and with its one default buckling factor of a pair 225.6
+// where it is 75.2 (an adversarial review, 2026-12-01). Two cover a pair at the last mode asked
+// for and a triple's first two; a longer cluster reaching the last mode computed is unknown (4).
+inline constexpr int kSensitivityGuardModes = 2;
+
+// The derivatives of the eigenvalues `lambdas` (ascending: every one computed from the lowest,
+// so that clusters are found; `complete` when they are every one there is, else the last cluster,
+// which may go on beyond them, is unknown) of K phi = lambda M phi with M-normalized `shapes`
+// (columns) about `base` (data of base_model), K the symmetric part of -dW/du at time t and
+// load_factor (the tangent the modal analysis uses).
 EigenvalueDerivatives eigenvalue_derivatives(const Model& base_model, const Data& base,
                                              const DesignStep& step, const Eigen::VectorXd& v,
                                              double t, double load_factor,
                                              const std::vector<double>& lambdas,
-                                             const Eigen::MatrixXd& shapes);
+                                             const Eigen::MatrixXd& shapes, bool complete);
 
-// The derivatives of the buckling factors `factors` (ascending, every one computed) with shapes
+// The derivatives of the buckling factors `factors` (ascending, every one computed from the
+// lowest; `complete` as for eigenvalue_derivatives) with shapes
 // `shapes` (columns) about the reference state `base` (data of `reference`), exact: the models
 // along the design direction of the reference structure and of the structure with the loads to
 // scale (values those of `reference` and the scaled structure), v = du/dp of the reference state
@@ -139,6 +151,6 @@ EigenvalueDerivatives buckling_factor_derivatives(const Model& reference, const 
                                                   const DualModel& scaled_direction,
                                                   const Eigen::VectorXd& v, double t,
                                                   const std::vector<double>& factors,
-                                                  const Eigen::MatrixXd& shapes);
+                                                  const Eigen::MatrixXd& shapes, bool complete);
 
 }  // namespace beamrail

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 
+#include "core/analysis/sensitivity.hpp"
 #include "core/analysis/stop_request.hpp"
 #include "optimizer/run/expressions.hpp"
 #include "optimizer/run/number_text.hpp"
@@ -172,6 +173,7 @@ class Runner {
     options.structure_cache = structure_cache();  // the designs share the ordering of K + mu M
     for (const ResponseSpec& response : study_.responses)
       options.keep_mass = options.keep_mass || (response.analysis == index && response.track);
+    if (options_.keep_states) options.guard_modes = kSensitivityGuardModes;
     const ModalResult r = solve_modal(model, options, data);
     report.ok = r.ok;
     report.timed_out = r.timed_out;
@@ -234,6 +236,7 @@ class Runner {
       data.rotation = e.data->rotation;
     }
     options.max_seconds = budget_left(options.max_seconds);
+    if (options_.keep_states) options.guard_modes = kSensitivityGuardModes;
     const BucklingResult r = solve_buckling(*reference, scaled, options, data);
     report.ok = r.ok;
     report.timed_out = r.timed_out;
@@ -246,11 +249,14 @@ class Runner {
     if (!r.ok) return;
     buckling_responses(study_, index, r, ev_.responses);
     state.ok = true;
-    state.shapes.resize(model_.n_dofs, static_cast<Eigen::Index>(r.modes.size()));
-    for (size_t m = 0; m < r.modes.size(); ++m) {
-      state.eigenvalues.push_back(r.modes[m].factor);
-      state.shapes.col(static_cast<Eigen::Index>(m)) = r.modes[m].shape;
-    }
+    state.shapes.resize(model_.n_dofs, static_cast<Eigen::Index>(r.modes.size() + r.guard.size()));
+    Eigen::Index column = 0;
+    for (const std::vector<BucklingMode>* list : {&r.modes, &r.guard})
+      for (const BucklingMode& mode : *list) {
+        state.eigenvalues.push_back(mode.factor);
+        state.shapes.col(column++) = mode.shape;
+      }
+    state.complete = static_cast<int>(r.guard.size()) < options.guard_modes;
     state.response_mode.assign(study_.responses.size(), -1);
     for (size_t k = 0; k < study_.responses.size(); ++k) {
       const ResponseSpec& rs = study_.responses[k];
@@ -395,12 +401,17 @@ class Runner {
     int n = 0;
     for (size_t m = 0; m < r.modes.size(); ++m)
       if (r.modes[m].kind != Mode::Kind::kRigid) column[m] = n++;
-    state.shapes.resize(model.n_dofs, n);
+    state.shapes.resize(model.n_dofs, n + static_cast<int>(r.guard.size()));
     for (size_t m = 0; m < r.modes.size(); ++m)
       if (column[m] >= 0) {
         state.eigenvalues.push_back(r.modes[m].eigenvalue);
         state.shapes.col(column[m]) = r.modes[m].shape;
       }
+    for (const Mode& mode : r.guard) {
+      state.shapes.col(static_cast<Eigen::Index>(state.eigenvalues.size())) = mode.shape;
+      state.eigenvalues.push_back(mode.eigenvalue);
+    }
+    state.complete = static_cast<int>(r.guard.size()) < options.guard_modes;
     state.response_mode.assign(chosen.size(), -1);
     for (size_t k = 0; k < chosen.size(); ++k)
       if (chosen[k] >= 0) state.response_mode[k] = column[chosen[k]];

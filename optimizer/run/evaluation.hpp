@@ -96,6 +96,9 @@ struct EvaluationStates {
     // buckling: every positive factor computed and its shape
     std::vector<double> eigenvalues;
     Eigen::MatrixXd shapes;
+    // With the guard's modes (kSensitivityGuardModes, when its sensitivities are wanted) after
+    // those asked for; complete: every mode there is (the guard found fewer than it asked).
+    bool complete = false;
     bool nonsymmetric = false;
     std::vector<int> response_mode;  // per study response: the column of `shapes` it reads, or -1
     // buckling: the structure with its constant loads, and with the loads to scale

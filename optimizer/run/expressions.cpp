@@ -2,6 +2,7 @@
 
 #include <muParser.h>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <functional>
@@ -144,7 +145,8 @@ std::vector<std::string> evaluate_expressions(const Study& study, std::vector<do
 }
 
 void chain_expression_derivatives(const Study& study, const std::vector<double>& values,
-                                  Eigen::Ref<Eigen::MatrixXd> jacobian) {
+                                  Eigen::Ref<Eigen::MatrixXd> jacobian,
+                                  std::vector<std::string>* warnings) {
   for (int k : study.expression_order) {
     const ResponseSpec& r = study.responses[k];
     jacobian.row(k).setZero();
@@ -159,6 +161,45 @@ void chain_expression_derivatives(const Study& study, const std::vector<double>&
       at[i] = values[i];
       jacobian.row(k) += partial * jacobian.row(i);
     }
+    // Along each variable's direction (the inputs' derivatives), one-sided differences of the
+    // expression at steps h and h / 2 (Richardson: second order), h moving no input by more than
+    // the parser's own step.
+    std::string kinked;
+    for (Eigen::Index j = 0; j < jacobian.cols(); ++j) {
+      double h = std::numeric_limits<double>::infinity();
+      bool known = std::isfinite(values[k]);
+      for (int i : r.inputs) {
+        const double d = jacobian(i, j);
+        known = known && std::isfinite(d) && std::isfinite(values[i]);
+        if (d != 0.0)
+          h = std::min(h, (values[i] != 0.0 ? 1e-7 * std::abs(values[i]) : 1e-10) / std::abs(d));
+      }
+      if (!known || !std::isfinite(h)) continue;  // NaN stays NaN; no input moves: 0
+      const auto along = [&](double step) {
+        for (int i : r.inputs) at[i] = values[i] + step * jacobian(i, j);
+        const double e = parser.Eval();
+        for (int i : r.inputs) at[i] = values[i];
+        return (e - values[k]) / step;
+      };
+      const double one_sided = 2.0 * along(0.5 * h) - along(h);
+      const double chain = jacobian(k, j);
+      // Rounding of the differences: eps |e| / h, with room.
+      const double noise = 1e3 * std::numeric_limits<double>::epsilon() * std::abs(values[k]) / h;
+      if (std::abs(one_sided - chain) >
+          kExpressionKink * std::max(std::abs(one_sided), std::abs(chain)) + noise) {
+        jacobian(k, j) = one_sided;
+        kinked += (kinked.empty() ? "\"" : ", \"") +
+                  (study.design && j < static_cast<Eigen::Index>(study.design->variables.size())
+                       ? study.design->variables[j].name
+                       : std::to_string(j + 1)) +
+                  "\"";
+      }
+    }
+    if (!kinked.empty() && warnings)
+      warnings->push_back("expression \"" + r.name +
+                          "\" has a kink at this design (max, min, abs or a comparison at a tie "
+                          "of its inputs) along variable(s) " +
+                          kinked + ": its derivative there is the one as the variable grows");
   }
 }
 

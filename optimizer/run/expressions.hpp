@@ -30,8 +30,19 @@ std::vector<std::string> evaluate_expressions(const Study& study, std::vector<do
 
 // The rows of `jacobian` (responses x variables) of the expression responses, by the chain rule
 // from the rows of the responses they read: d e / d r by muparser's numerical derivative at
-// `values` (the responses of the design).
+// `values` (the responses of the design). Where an expression has a kink along a variable's
+// direction (max, min, abs or a comparison at a tie of its inputs), that difference gives the
+// average of the two sides (max(dy, c) at dy = c: half the slope as the load grows, which
+// differences of whole evaluations confirm, as they are central too; an adversarial review,
+// 2026-12-01): there the derivative is the one as the variable grows, from one-sided differences
+// of the expression along the inputs' derivatives (kExpressionKink), and `warnings` says so.
 void chain_expression_derivatives(const Study& study, const std::vector<double>& values,
-                                  Eigen::Ref<Eigen::MatrixXd> jacobian);
+                                  Eigen::Ref<Eigen::MatrixXd> jacobian,
+                                  std::vector<std::string>* warnings);
+
+// The relative disagreement between the chain rule and the one-sided difference of an expression
+// along a variable beyond which the expression has a kink there (smooth expressions agree to
+// ~1e-9; a kink differs by a share of the slope).
+inline constexpr double kExpressionKink = 1e-5;
 
 }  // namespace beamrail

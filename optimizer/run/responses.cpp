@@ -87,9 +87,52 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
   }
 }
 
+double max_stress_derivative(const std::vector<const SectionPropertiesT<HyperDual>*>& sections,
+                             const std::vector<EndForcesT<HyperDual>>& forces, bool* kink) {
+  // The stresses' values first: the largest sets what counts as zero and as a tie.
+  const auto term_value = [](const HyperDual& f, const HyperDual& w) { return std::abs(f.v) / w.v; };
+  double worst = 0.0;
+  for (size_t i = 0; i < forces.size(); ++i)
+    for (const Vec6T<HyperDual>* p : {&forces[i].end1, &forces[i].end2}) {
+      const SectionPropertiesT<HyperDual>& s = *sections[i];
+      if (!(s.area.v > 0.0) || !(s.wy.v > 0.0) || !(s.wz.v > 0.0))
+        return std::numeric_limits<double>::quiet_NaN();
+      worst = std::max(worst, term_value((*p)(0), s.area) + term_value((*p)(4), s.wy) +
+                                  term_value((*p)(5), s.wz));
+    }
+  const double zero = kStressKink * worst;
+  double best = -std::numeric_limits<double>::infinity(), lowest_tied = best;
+  double kinked = 0.0;  // the derivative's part from the terms at their kink
+  for (size_t i = 0; i < forces.size(); ++i)
+    for (const Vec6T<HyperDual>* p : {&forces[i].end1, &forces[i].end2}) {
+      const SectionPropertiesT<HyperDual>& s = *sections[i];
+      double value = 0.0, derivative = 0.0;
+      for (const auto& [f, w] : {std::pair{(*p)(0), s.area}, std::pair{(*p)(4), s.wy},
+                                 std::pair{(*p)(5), s.wz}}) {
+        value += term_value(f, w);
+        if (term_value(f, w) <= zero) {
+          // |f| / w at f = 0 (up to rounding): |df| / w as p grows.
+          derivative += std::abs(f.b) / w.v;
+          kinked = std::max(kinked, std::abs(f.b) / w.v);
+        } else {
+          derivative += (f.v < 0.0 ? -f.b : f.b) / w.v - std::abs(f.v) * w.b / (w.v * w.v);
+        }
+      }
+      if (value < worst - zero) continue;  // not the largest
+      lowest_tied = best == -std::numeric_limits<double>::infinity()
+                        ? derivative
+                        : std::min(lowest_tied, derivative);
+      best = std::max(best, derivative);
+    }
+  const double scale = std::abs(best);
+  *kink = kinked > kStressKink * scale || best - lowest_tied > kStressKink * scale;
+  return best;
+}
+
 void static_response_derivatives(const Study& study, int analysis, const Model& base,
                                  const Data& data, const DualModel& direction,
-                                 const Eigen::VectorXd& v, std::vector<double>& values) {
+                                 const Eigen::VectorXd& v, std::vector<double>& values,
+                                 std::vector<std::string>* warnings) {
   using H = HyperDual;
   const std::vector<Pose<H>> pose = dual_poses(base, data, direction, v, Eigen::VectorXd());
   for (size_t k = 0; k < study.responses.size(); ++k) {
@@ -126,20 +169,35 @@ void static_response_derivatives(const Study& study, int analysis, const Model& 
         break;
       }
       case ResponseSpec::Quantity::kJointGap: {
-        // d|g| = g . dg / |g|: a joint at rest (g = 0) has no derivative; 0 is given there.
+        // d|g| = g . dg / |g|; at g = 0 (a joint that carries nothing) |g| has a kink, and its
+        // derivative as the variables grow is |dg|.
         const JointT<H>& j = direction.joints[r.joint];
         const Vec3T<H> g = joint_gap(j, pose[j.body1], pose[j.body2]);
         const H squared = g.dot(g);
-        values[k] = squared.v > 0.0 ? 0.5 * squared.b / std::sqrt(squared.v) : 0.0;
+        Vec3 dg;
+        for (int c = 0; c < 3; ++c) dg(c) = g(c).b;
+        values[k] = squared.v > 0.0 ? 0.5 * squared.b / std::sqrt(squared.v) : dg.norm();
+        if (!(squared.v > 0.0) && dg.norm() > 0.0 && warnings)
+          warnings->push_back("joint_gap response \"" + r.name +
+                              "\" is at a kink (the joint carries nothing): its derivative is "
+                              "the one as the variables grow");
         break;
       }
       case ResponseSpec::Quantity::kMaxStress: {
-        H worst = 0.0;
+        std::vector<EndForcesT<H>> forces;
+        std::vector<const SectionPropertiesT<H>*> sections;
         for (int i : r.beams) {
-          const H s = end_stress(direction.beams[i].section, beam_end_forces(direction, pose, i));
-          if (s > worst) worst = s;
+          forces.push_back(beam_end_forces(direction, pose, i));
+          sections.push_back(&direction.beams[i].section);
         }
-        values[k] = worst.b;
+        bool kink = false;
+        values[k] = max_stress_derivative(sections, forces, &kink);
+        if (kink && warnings)
+          warnings->push_back(
+              "max_stress response \"" + r.name +
+              "\" is at a kink (a force of a section that is zero, or two ends equally "
+              "stressed): its derivative is the one as the variables grow, and the other way it "
+              "differs");
         break;
       }
       default:

@@ -8,6 +8,7 @@
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/sensitivity.hpp"
 #include "core/model/data.hpp"
+#include "core/model/element_forces.hpp"
 #include "core/model/element_kinds.hpp"
 #include "optimizer/study/study.hpp"
 
@@ -67,9 +68,27 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
 // The total derivatives along a design direction of the static responses of `analysis`, written
 // where static_responses writes their values: the responses on hyper-dual numbers over
 // `direction` at the equilibrium `data` (of `base`) moved by e2 v (v = du/dp), their e2 parts.
+// Where a response is not smooth (a max_stress whose force is zero or whose largest ends tie, a
+// joint_gap of a joint carrying nothing) its derivative is the one as the variables grow, and a
+// warning says so (into `warnings`).
 void static_response_derivatives(const Study& study, int analysis, const Model& base,
                                  const Data& data, const DualModel& direction,
-                                 const Eigen::VectorXd& v, std::vector<double>& values);
+                                 const Eigen::VectorXd& v, std::vector<double>& values,
+                                 std::vector<std::string>* warnings);
+
+// Relative to the largest stress: a stress term |N|/S, |My|/Wy or |Mz|/Wz below this is a zero
+// force (rounding leaves ~1e-16: a planar frame's out-of-plane moment), and ends within it of the
+// largest tie. Relative to the derivative: a kink's share that counts.
+inline constexpr double kStressKink = 1e-9;
+
+// The derivative, as the variables grow, of max_stress over the beams' end forces `forces` (on
+// hyper-dual numbers: e2 along the design) with `sections`: |f| at f = 0 grows as |df|, and of
+// tied ends the largest derivative wins. *kink when either changed it (the derivative the other
+// way differs). NaN when a section modulus is unknown. An adversarial review (2026-12-01) found
+// a column turned about its axis by p (its section's axes) with dstress/dp -5.06e7 Pa/m where
+// the stress is V-shaped about p = 0 and grows by 5.06e7 Pa/m either way: |Mz| was -1e-16.
+double max_stress_derivative(const std::vector<const SectionPropertiesT<HyperDual>*>& sections,
+                             const std::vector<EndForcesT<HyperDual>>& forces, bool* kink);
 
 // A mode shape by body name (dc, dtheta of each free body): comparable between designs whose
 // bodies are numbered differently.

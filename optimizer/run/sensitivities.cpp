@@ -16,6 +16,11 @@
 namespace beamrail {
 namespace {
 
+// The warning of a mode in a cluster that reaches past the modes computed (crossing 4).
+constexpr const char* kBeyondComputed =
+    "repeated with modes beyond those computed (those asked for and two more): its derivative is "
+    "not known (NaN); ask the analysis for more modes";
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 template <class A, class B>
@@ -118,7 +123,7 @@ ResponseSensitivities Sensitivities::run(const std::vector<DualModel>& direction
     out.jacobian.col(j) = per[j].jacobian.col(0);
     for (std::string& w : per[j].warnings) out.warnings.push_back(std::move(w));
   }
-  chain_expression_derivatives(design_, ev_.responses, out.jacobian);
+  chain_expression_derivatives(design_, ev_.responses, out.jacobian, &out.warnings);
   for (int k = 0; k < nr; ++k) {
     if (std::isnan(ev_.responses[k])) {
       out.jacobian.row(k).setConstant(kNaN);
@@ -195,7 +200,7 @@ bool Sensitivities::variable(int j, const DualModel& direction, ResponseSensitiv
         const EvaluationStates::Equilibrium& e = states.equilibria.at(a.equilibrium);
         std::vector<double> d(nr, kNaN);
         static_response_derivatives(design_, index, *e.model, *e.data, models_of(spec.load_case),
-                                    du, d);
+                                    du, d, &out.warnings);
         for (int k = 0; k < nr; ++k)
           if (design_.responses[k].analysis == index) column(k) = d[k];
         break;
@@ -203,36 +208,46 @@ bool Sensitivities::variable(int j, const DualModel& direction, ResponseSensitiv
       case AnalysisSpec::Type::kModal: {
         const EigenvalueDerivatives d =
             eigenvalue_derivatives(*a.model, *a.data, {&models_of(spec.load_case)}, du, a.time,
-                                   a.load_factor, a.eigenvalues, a.shapes);
+                                   a.load_factor, a.eigenvalues, a.shapes, a.complete);
         for (int k = 0; k < nr; ++k) {
           const int m = a.response_mode[k];
           if (m < 0) continue;
           // f = sqrt(lambda) / (2 pi): df = dlambda / (8 pi^2 f).
           const double f = std::sqrt(a.eigenvalues[m]) / (2.0 * std::numbers::pi);
           column(k) = d.values[m] / (8.0 * std::numbers::pi * std::numbers::pi * f);
-          if (d.crossing[m] == 1 || d.crossing[m] == 2)
+          if (d.crossing[m] >= 1 && d.crossing[m] != 3)
             out.warnings.push_back(
                 "frequency response \"" + design_.responses[k].name + "\" (mode " +
                 std::to_string(m + 1) + ") is " +
                 (d.crossing[m] == 2
                      ? "on a crossing of modes (a repeated frequency): its derivative is the "
                        "directional one as the variables grow"
+                 : d.crossing[m] == 4
+                     ? kBeyondComputed
                      : "near a crossing of modes: its derivative changes quickly with the design"));
         }
         break;
       }
       case AnalysisSpec::Type::kBuckling: {
         const auto [reference, scaled] = buckling_models(direction, spec.load_case);
-        const EigenvalueDerivatives d = buckling_factor_derivatives(
-            *a.reference, *a.data, reference, scaled, du, a.time, a.eigenvalues, a.shapes);
+        const EigenvalueDerivatives d =
+            buckling_factor_derivatives(*a.reference, *a.data, reference, scaled, du, a.time,
+                                        a.eigenvalues, a.shapes, a.complete);
         for (int k = 0; k < nr; ++k) {
           const int m = a.response_mode[k];
           if (m < 0) continue;
           column(k) = d.values[m];
-          if (d.crossing[m] == 2)
-            out.warnings.push_back("buckling factor \"" + design_.responses[k].name +
-                                   "\" is a repeated factor: its derivative is the "
-                                   "directional one as the variables grow");
+          if (d.crossing[m] >= 1 && d.crossing[m] != 3)
+            out.warnings.push_back(
+                "buckling factor \"" + design_.responses[k].name + "\" (mode " +
+                std::to_string(m + 1) + ") is " +
+                (d.crossing[m] == 2
+                     ? "a repeated factor: its derivative is the directional one as the "
+                       "variables grow"
+                 : d.crossing[m] == 4
+                     ? kBeyondComputed
+                     : "near a crossing of modes: its derivative changes quickly with the "
+                       "design"));
         }
         break;
       }

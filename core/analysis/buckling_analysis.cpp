@@ -97,6 +97,10 @@ std::vector<Mat6> element_tangent_at(const Model& model, Data& data, const Saved
   return data.stiffness;
 }
 
+// The most strain or rotation per unit load factor (motion_scale of u1 = K0^-1 P1) a buckling
+// analysis takes: factors below its inverse are refused (their stress stiffness overflows).
+constexpr double kMostMotionPerFactor = 1e100;
+
 // The largest rotation, or displacement over `length`, of a motion x (dim n_dofs).
 double motion_scale(const Eigen::VectorXd& x, double length) {
   double s = 0.0;
@@ -183,6 +187,16 @@ BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, 
         "the reference state's tangent stiffness is singular (a body or mechanism free to "
         "move): buckling needs every body held");
 
+  // Loads that move the structure by more than kMostMotionPerFactor per unit factor (a factor
+  // below its inverse) overflow the stress stiffness's products in double precision: 1e200 N on a
+  // column gave no factor (infinite: "they compress too little"), with status ok, where 1e100 N
+  // gives the Euler load over the load to the digit (an adversarial review, 2026-12-01).
+  if (!(motion_scale(u1, length) <= kMostMotionPerFactor))
+    throw std::runtime_error(
+        text("the scaled loads reach beyond double precision: per unit factor they would strain "
+             "or turn the structure by %.2g, so the factor is below 1e-100, which the analysis "
+             "cannot resolve; scale the loads down",
+             motion_scale(u1, length)));
   // K1 = d K / d lambda: the element tangent's central differences along u1 at steps h and
   // h / 2, extrapolated, plus the load stiffness's change (exact).
   const double h = kStep / std::max(motion_scale(u1, length), 1e-300);
@@ -282,6 +296,17 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
     const SparseMatrix& k0 = matrices.k0;
     const Eigen::SimplicialLLT<SparseMatrix>& llt = *matrices.llt;
     const SparseMatrix minus_k1 = -matrices.k1;
+    const char* beyond_precision =
+        "the scaled loads reach beyond double precision: the stiffness they cause is not finite; "
+        "scale the loads down";
+    // Loads of 1e200 N and more overflow the stress stiffness they cause: its entries and the
+    // factors would be inf or NaN, read as "no factor" (infinite, the structure unbuckled; an
+    // adversarial review, 2026-12-01).
+    const auto finite = [](const SparseMatrix& a) {
+      return Eigen::Map<const Eigen::VectorXd>(a.valuePtr(), a.nonZeros()).allFinite();
+    };
+    if (!finite(minus_k1) || !finite(k0) || !matrices.u1.allFinite())
+      throw std::runtime_error(beyond_precision);
 
     // -K1 x = mu K0 x, mu = 1 / lambda: the largest positive mu are the lowest positive factors.
     const int wanted = std::max(1, options.modes);
@@ -310,6 +335,7 @@ BucklingResult solve_buckling(const Model& reference, const Model& scaled,
       vectors = eigs.eigenvectors();
       result.solver = "lanczos";
     }
+    if (!mu.allFinite()) throw std::runtime_error(beyond_precision);
     // Rounding leaves |mu| ~ 1e-16 max |mu| in directions the scaled loads do not stress: no
     // factor of their own.
     const double floor = 1e-12 * mu.cwiseAbs().maxCoeff();

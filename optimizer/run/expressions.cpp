@@ -41,6 +41,43 @@ std::vector<std::string> used_names(const std::string& expression) {
   return names;
 }
 
+// What makes an expression more than a formula of its inputs, "" when nothing: an assignment
+// ("buckling = buckling * 100" wrote 385.02 into the response buckling, reported as such with
+// status ok; an adversarial review, 2026-12-01), or several results ("stress, buckling" gave the
+// last).
+std::string not_a_formula(const std::string& expression) {
+  for (size_t i = 0; i < expression.size(); ++i) {
+    if (expression[i] != '=') continue;
+    const char before = i > 0 ? expression[i - 1] : ' ';
+    const char after = i + 1 < expression.size() ? expression[i + 1] : ' ';
+    if (after == '=') {  // "==": skip its second sign
+      ++i;
+      continue;
+    }
+    if (before == '<' || before == '>' || before == '!') continue;
+    const bool compound = std::string("+-*/^").find(before) != std::string::npos;
+    return "an assignment (\"" + (compound ? std::string(1, before) : std::string()) +
+           "=\") would write into a response; an expression is a formula of responses (compare "
+           "with ==)";
+  }
+  std::lock_guard<std::mutex> lock(parser_mutex());
+  std::deque<double> storage;
+  mu::Parser parser;
+  parser.SetVarFactory(
+      [](const char*, void* data) -> double* {
+        auto* s = static_cast<std::deque<double>*>(data);
+        s->push_back(1.0);
+        return &s->back();
+      },
+      &storage);
+  parser.SetExpr(expression);
+  parser.Eval();
+  if (parser.GetNumResults() > 1)
+    return std::to_string(parser.GetNumResults()) +
+           " results separated by commas; an expression gives one number";
+  return "";
+}
+
 int response_index(const Study& study, const std::string& name) {
   for (size_t k = 0; k < study.responses.size(); ++k)
     if (study.responses[k].name == name) return static_cast<int>(k);
@@ -58,6 +95,10 @@ void resolve_expressions(Study& study, Diagnostics& diag, const std::set<std::st
     std::vector<std::string> names;
     try {
       names = used_names(r.expression);
+      if (const std::string problem = not_a_formula(r.expression); !problem.empty()) {
+        diag.error(at.file, at.pointer, problem + " in \"" + r.expression + "\"");
+        continue;
+      }
     } catch (const mu::Parser::exception_type& e) {
       diag.error(at.file, at.pointer, e.GetMsg() + " in \"" + r.expression + "\"");
       continue;
@@ -124,7 +165,8 @@ std::vector<std::string> evaluate_expressions(const Study& study, std::vector<do
     try {
       std::lock_guard<std::mutex> lock(parser_mutex());
       mu::Parser parser;
-      for (int i : r.inputs) parser.DefineVar(study.responses[i].name, &values[i]);
+      std::vector<double> inputs = values;  // the parser reads a copy: nothing writes a response
+      for (int i : r.inputs) parser.DefineVar(study.responses[i].name, &inputs[i]);
       parser.SetExpr(r.expression);
       values[k] = parser.Eval();
     } catch (const mu::Parser::exception_type& e) {

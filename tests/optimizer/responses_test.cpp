@@ -68,6 +68,10 @@ TEST(Responses, ExpressionsOverOtherResponsesInDependencyOrder) {
   doc["responses"]["a_worst"] = {{"quantity", "expression"},
                                  {"expression", "max(abs(dy), abs(dz), z_mag / 2)"}};
   doc["responses"]["z_mag"] = {{"quantity", "expression"}, {"expression", "sqrt(dy^2 + dz^2)"}};
+  // Comparisons are no assignments.
+  doc["responses"]["tests"] = {
+      {"quantity", "expression"},
+      {"expression", "(dy >= dz) + 2 * (dy != dz) + 4 * (dy == dy) + 8 * (dy <= dz)"}};
   Evaluation ev;
   const auto v = evaluate_named(doc, &ev);
   ASSERT_EQ(ev.status, Status::kOk) << ev.message;
@@ -75,6 +79,8 @@ TEST(Responses, ExpressionsOverOtherResponsesInDependencyOrder) {
   EXPECT_EQ(v.at("z_mag"), std::sqrt(v.at("dy") * v.at("dy") + v.at("dz") * v.at("dz")));
   EXPECT_EQ(v.at("a_worst"),
             std::max({std::abs(v.at("dy")), std::abs(v.at("dz")), v.at("z_mag") / 2}));
+  const double dy = v.at("dy"), dz = v.at("dz");
+  EXPECT_EQ(v.at("tests"), (dy >= dz) + 2 * (dy != dz) + 4 + 8 * (dy <= dz));
   EXPECT_TRUE(ev.warnings.empty());
 }
 
@@ -149,6 +155,12 @@ TEST(Responses, BadExpressionsMassesAndLinksAreRefusedWithTheirPointers) {
   expect_refused(doc, "/responses/e/expression", "\"dx\" is no response of the study");
   doc["responses"]["e"]["expression"] = "e + 1";
   expect_refused(doc, "/responses/e/expression", "reads its own response \"e\"");
+  // An assignment wrote into the response it named ("dy = dy * 100": dy reported 100 times its
+  // value, status ok; an adversarial review, 2026-12-01), and several results gave the last.
+  doc["responses"]["e"]["expression"] = "dy = dy * 100";
+  expect_refused(doc, "/responses/e/expression", "an assignment (\"=\") would write into a response");
+  doc["responses"]["e"]["expression"] = "dy, 2 * dy";
+  expect_refused(doc, "/responses/e/expression", "2 results separated by commas");
   doc["responses"]["e"]["expression"] = "f + 1";
   doc["responses"]["f"] = {{"quantity", "expression"}, {"expression", "2 * e"}};
   expect_refused(doc, "/responses/f/expression", "a cycle");

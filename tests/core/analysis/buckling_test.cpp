@@ -98,6 +98,28 @@ TEST(Buckling, ClampedFreeColumnConvergesToEulerAtSecondOrder) {
                       [](int n) { return cantilever_column(n, 100.0).model(); });
 }
 
+// Loads of 1e200 N overflow the stiffness they cause: the analysis fails and says so, where it
+// reported no factor (infinite: "they compress too little") with status ok; at 1e100 N the factor
+// is the Euler load over the load to the digit (an adversarial review, 2026-12-01).
+TEST(Buckling, LoadsBeyondDoublePrecisionFailAndSaySo) {
+  const double exact = kEulerBase / 4.0;
+  const BucklingResult large = buckle(cantilever_column(16, 1e100).model(), "");
+  ASSERT_TRUE(large.ok) << large.message;
+  const BucklingResult small = buckle(cantilever_column(16, 100.0).model(), "");
+  ASSERT_TRUE(small.ok) << small.message;
+  std::printf("factor times the load: %.12g N at 1e100 N, %.12g N at 100 N (Euler %.12g N)\n",
+              large.modes[0].factor * 1e100, small.modes[0].factor * 100.0, exact);
+  EXPECT_NEAR(large.modes[0].factor * 1e100 / (small.modes[0].factor * 100.0), 1.0, 1e-12);
+  for (double load : {1e200, 1e300}) {
+    const BucklingResult r = buckle(cantilever_column(16, load).model(), "");
+    std::printf("%g N: ok %d, %s, %zu factors (%g), %zu warnings %s\n", load, r.ok, r.message.c_str(),
+                r.modes.size(), r.modes.empty() ? 0.0 : r.modes[0].factor * load,
+                r.warnings.size(), r.warnings.empty() ? "" : r.warnings[0].c_str());
+    EXPECT_FALSE(r.ok);
+    EXPECT_NE(r.message.find("beyond double precision"), std::string::npos) << r.message;
+  }
+}
+
 // Pinned ends: a short beam along the pin axis (z) with a negligible torsion constant turns
 // freely about it and holds everything else. The base hinges to the ground; the top hinges to a
 // slider that a prismatic rail along the column guides (free along x, held otherwise).

@@ -48,9 +48,10 @@ const char* kScene = R"({
   ]
 })";
 
-TEST(Dynamics, ExactJacobianMatchesCentralDifferences) {
-  const Model model = testing::scene_from_json(kScene);
-  ASSERT_EQ(model.n_free(), 3);
+// The worst row-relative difference between the exact state Jacobian and central differences
+// of the state derivative, at the scene's initial state perturbed (positions, orientations, the
+// quaternions left slightly off unit norm).
+double jacobian_difference(const Model& model) {
   Data data(model);
   const int n = model.n_states;
   Eigen::VectorXd y(n);
@@ -84,7 +85,49 @@ TEST(Dynamics, ExactJacobianMatchesCentralDifferences) {
     const double scale = std::max(exact.row(r).cwiseAbs().maxCoeff(), 1e-12);
     worst = std::max(worst, (exact.row(r) - fd.row(r)).cwiseAbs().maxCoeff() / scale);
   }
+  return worst;
+}
+
+TEST(Dynamics, ExactJacobianMatchesCentralDifferences) {
+  const Model model = testing::scene_from_json(kScene);
+  ASSERT_EQ(model.n_free(), 3);
+  const double worst = jacobian_difference(model);
   std::printf("state Jacobian: worst row-relative difference to central FD = %.2e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+// Joints of the three kinds between spinning bodies, a damped rod between them.
+const char* kJointScene = R"({
+  "gravity": [0, -9.81, 0],
+  "materials": {"soft": {"E": 2.1e9, "G": 0.8e9, "density": 1000}},
+  "sections": {"rod": {"shape": "circle", "diameter": 0.02}},
+  "bodies": [
+    {"name": "arm", "mass": 1.0, "inertia": [1e-3, 2e-3, 3e-3], "position": [0.1, 0, 0],
+     "velocity": [0, 0.8, 0], "angular_velocity": [0.3, -0.2, 8]},
+    {"name": "tip", "mass": 0.1, "inertia": [1e-5, 2e-5, 1.5e-5], "position": [0.5, 0, 0],
+     "velocity": [0, 4, 0], "angular_velocity": [0, 0.5, 8]},
+    {"name": "ball", "mass": 0.3, "inertia": [1e-4, 1e-4, 2e-4], "position": [0.6, 0.05, 0.02],
+     "orientation": [0.5, 0.5, 0.5, 0.5], "angular_velocity": [2, 1, -3]},
+    {"name": "weight", "mass": 0.2, "inertia": [1e-4, 1.2e-4, 0.8e-4], "position": [0.1, -0.1, 0]}
+  ],
+  "beams": [
+    {"name": "rod", "body1": "arm", "body2": "tip", "point1": [0.1, 0, 0], "point2": [0.5, 0, 0],
+     "point3": [0.1, 1, 0], "material": "soft", "section": "rod", "damping": 1e-4}
+  ],
+  "joints": [
+    {"name": "pin", "type": "revolute", "body1": "ground", "body2": "arm", "point": [0, 0, 0],
+     "axis": [0, 0, 1]},
+    {"name": "knuckle", "type": "spherical", "body1": "tip", "body2": "ball",
+     "point": [0.55, 0.02, 0.01]},
+    {"name": "weld", "type": "fixed", "body1": "arm", "body2": "weight", "point": [0.1, -0.05, 0]}
+  ]
+})";
+
+TEST(Dynamics, ExactJacobianOfJointsMatchesCentralDifferences) {
+  const Model model = testing::scene_from_json(kJointScene);
+  ASSERT_EQ(model.n_free(), 4);
+  const double worst = jacobian_difference(model);
+  std::printf("joints: worst row-relative difference to central FD = %.2e\n", worst);
   EXPECT_LT(worst, 1e-6);
 }
 

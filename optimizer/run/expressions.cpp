@@ -23,42 +23,35 @@ std::mutex& parser_mutex() {
   return m;
 }
 
-// Every name the expression uses as a variable (muparser creates them through the factory).
-std::vector<std::string> used_names(const std::string& expression) {
-  std::lock_guard<std::mutex> lock(parser_mutex());
-  std::deque<double> storage;
-  mu::Parser parser;
-  parser.SetVarFactory(
-      [](const char*, void* data) -> double* {
-        auto* s = static_cast<std::deque<double>*>(data);
-        s->push_back(0.0);
-        return &s->back();
-      },
-      &storage);
-  parser.SetExpr(expression);
-  std::vector<std::string> names;
-  for (const auto& [name, value] : parser.GetUsedVar()) names.push_back(name);
-  return names;
-}
-
-// What makes an expression more than a formula of its inputs, "" when nothing: an assignment
-// ("buckling = buckling * 100" wrote 385.02 into the response buckling, reported as such with
-// status ok; an adversarial review, 2026-12-01), or several results ("stress, buckling" gave the
-// last).
-std::string not_a_formula(const std::string& expression) {
+// An assignment operator in the expression, "" when none: "=", or "+=" and the like, not a
+// comparison (==, <=, >=, !=).
+std::string assignment(const std::string& expression) {
   for (size_t i = 0; i < expression.size(); ++i) {
     if (expression[i] != '=') continue;
     const char before = i > 0 ? expression[i - 1] : ' ';
-    const char after = i + 1 < expression.size() ? expression[i + 1] : ' ';
-    if (after == '=') {  // "==": skip its second sign
+    if (i + 1 < expression.size() && expression[i + 1] == '=') {  // "==": skip its second sign
       ++i;
       continue;
     }
     if (before == '<' || before == '>' || before == '!') continue;
-    const bool compound = std::string("+-*/^").find(before) != std::string::npos;
-    return "an assignment (\"" + (compound ? std::string(1, before) : std::string()) +
-           "=\") would write into a response; an expression is a formula of responses (compare "
-           "with ==)";
+    return std::string("+-*/^").find(before) != std::string::npos ? std::string(1, before) + "="
+                                                                  : "=";
+  }
+  return "";
+}
+
+// Every name the expression uses as a variable (muparser creates them through the factory), and
+// what makes it more than a formula of them into *problem ("" when nothing): an assignment
+// ("buckling = buckling * 100" wrote 385.02 into the response buckling, reported as such with
+// status ok; an adversarial review, 2026-12-01), or several results ("stress, buckling" gave the
+// last).
+std::vector<std::string> used_names(const std::string& expression, std::string* problem) {
+  problem->clear();
+  if (const std::string op = assignment(expression); !op.empty()) {
+    *problem = "an assignment (\"" + op +
+               "\") would write into a response; an expression is a formula of responses "
+               "(compare with ==)";
+    return {};
   }
   std::lock_guard<std::mutex> lock(parser_mutex());
   std::deque<double> storage;
@@ -71,11 +64,13 @@ std::string not_a_formula(const std::string& expression) {
       },
       &storage);
   parser.SetExpr(expression);
+  std::vector<std::string> names;
+  for (const auto& [name, value] : parser.GetUsedVar()) names.push_back(name);
   parser.Eval();
   if (parser.GetNumResults() > 1)
-    return std::to_string(parser.GetNumResults()) +
-           " results separated by commas; an expression gives one number";
-  return "";
+    *problem = std::to_string(parser.GetNumResults()) +
+               " results separated by commas; an expression gives one number";
+  return names;
 }
 
 int response_index(const Study& study, const std::string& name) {
@@ -94,8 +89,9 @@ void resolve_expressions(Study& study, Diagnostics& diag, const std::set<std::st
     const Where at = r.where / "expression";
     std::vector<std::string> names;
     try {
-      names = used_names(r.expression);
-      if (const std::string problem = not_a_formula(r.expression); !problem.empty()) {
+      std::string problem;
+      names = used_names(r.expression, &problem);
+      if (!problem.empty()) {
         diag.error(at.file, at.pointer, problem + " in \"" + r.expression + "\"");
         continue;
       }

@@ -90,7 +90,9 @@ void static_responses(const Study& study, int analysis, const Model& model, cons
 double max_stress_derivative(const std::vector<const SectionPropertiesT<HyperDual>*>& sections,
                              const std::vector<EndForcesT<HyperDual>>& forces, bool* kink) {
   // The stresses' values first: the largest sets what counts as zero and as a tie.
-  const auto term_value = [](const HyperDual& f, const HyperDual& w) { return std::abs(f.v) / w.v; };
+  const auto term_value = [](const HyperDual& f, const HyperDual& w) {
+    return std::abs(f.v) / w.v;
+  };
   double worst = 0.0;
   for (size_t i = 0; i < forces.size(); ++i)
     for (const Vec6T<HyperDual>* p : {&forces[i].end1, &forces[i].end2}) {
@@ -107,8 +109,8 @@ double max_stress_derivative(const std::vector<const SectionPropertiesT<HyperDua
     for (const Vec6T<HyperDual>* p : {&forces[i].end1, &forces[i].end2}) {
       const SectionPropertiesT<HyperDual>& s = *sections[i];
       double value = 0.0, derivative = 0.0;
-      for (const auto& [f, w] : {std::pair{(*p)(0), s.area}, std::pair{(*p)(4), s.wy},
-                                 std::pair{(*p)(5), s.wz}}) {
+      for (const auto& [f, w] :
+           {std::pair{(*p)(0), s.area}, std::pair{(*p)(4), s.wy}, std::pair{(*p)(5), s.wz}}) {
         value += term_value(f, w);
         if (term_value(f, w) <= zero) {
           // |f| / w at f = 0 (up to rounding): |df| / w as p grows.

@@ -16,10 +16,26 @@
 namespace beamrail {
 namespace {
 
-// The warning of a mode in a cluster that reaches past the modes computed (crossing 4).
-constexpr const char* kBeyondComputed =
-    "repeated with modes beyond those computed (those asked for and two more): its derivative is "
-    "not known (NaN); ask the analysis for more modes";
+// The warning of an eigenvalue response (`what`: `frequency response "f1"`) whose derivative
+// EigenvalueDerivatives::crossing qualifies, "" for none (0: alone; 3: a cluster that stays
+// repeated, whose derivative is its members' own).
+std::string crossing_warning(const std::string& what, int mode, int crossing, bool buckling) {
+  const std::string is = what + " (mode " + std::to_string(mode) + ") is ";
+  switch (crossing) {
+    case 1:
+      return is + "near a crossing of modes: its derivative changes quickly with the design";
+    case 2:
+      return is +
+             (buckling ? "a repeated factor" : "on a crossing of modes (a repeated frequency)") +
+             ": its derivative is the directional one as the variables grow";
+    case 4:
+      return is +
+             "repeated with modes beyond those computed (those asked for and two more): its "
+             "derivative is not known (NaN); ask the analysis for more modes";
+    default:
+      return "";
+  }
+}
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -215,16 +231,11 @@ bool Sensitivities::variable(int j, const DualModel& direction, ResponseSensitiv
           // f = sqrt(lambda) / (2 pi): df = dlambda / (8 pi^2 f).
           const double f = std::sqrt(a.eigenvalues[m]) / (2.0 * std::numbers::pi);
           column(k) = d.values[m] / (8.0 * std::numbers::pi * std::numbers::pi * f);
-          if (d.crossing[m] >= 1 && d.crossing[m] != 3)
-            out.warnings.push_back(
-                "frequency response \"" + design_.responses[k].name + "\" (mode " +
-                std::to_string(m + 1) + ") is " +
-                (d.crossing[m] == 2
-                     ? "on a crossing of modes (a repeated frequency): its derivative is the "
-                       "directional one as the variables grow"
-                 : d.crossing[m] == 4
-                     ? kBeyondComputed
-                     : "near a crossing of modes: its derivative changes quickly with the design"));
+          if (std::string w =
+                  crossing_warning("frequency response \"" + design_.responses[k].name + "\"",
+                                   m + 1, d.crossing[m], false);
+              !w.empty())
+            out.warnings.push_back(std::move(w));
         }
         break;
       }
@@ -237,17 +248,11 @@ bool Sensitivities::variable(int j, const DualModel& direction, ResponseSensitiv
           const int m = a.response_mode[k];
           if (m < 0) continue;
           column(k) = d.values[m];
-          if (d.crossing[m] >= 1 && d.crossing[m] != 3)
-            out.warnings.push_back(
-                "buckling factor \"" + design_.responses[k].name + "\" (mode " +
-                std::to_string(m + 1) + ") is " +
-                (d.crossing[m] == 2
-                     ? "a repeated factor: its derivative is the directional one as the "
-                       "variables grow"
-                 : d.crossing[m] == 4
-                     ? kBeyondComputed
-                     : "near a crossing of modes: its derivative changes quickly with the "
-                       "design"));
+          if (std::string w =
+                  crossing_warning("buckling factor \"" + design_.responses[k].name + "\"", m + 1,
+                                   d.crossing[m], true);
+              !w.empty())
+            out.warnings.push_back(std::move(w));
         }
         break;
       }

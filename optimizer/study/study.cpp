@@ -50,8 +50,8 @@ std::string write_segment_counts(Json& document, const std::vector<SegmentChoice
         continue;
       }
       *segments = choice->segments;
-      written += (written.empty() ? "" : ", ") + choice->beam + " " +
-                 std::to_string(choice->segments);
+      written +=
+          (written.empty() ? "" : ", ") + choice->beam + " " + std::to_string(choice->segments);
     }
   }
   if (!written.empty() && !auto_left) scene->erase("segmentation");

@@ -291,9 +291,9 @@ TEST_F(DesignStudyRuns, BestSceneKeepsTheAutoSegmentCountsOfTheDesigns) {
   std::printf("\nf1: best.json %s, best_scene.json run again %s\n",
               g17(best["responses"]["f1"]).c_str(), g17(again["responses"]["f1"]).c_str());
   EXPECT_FALSE(best_scene["scene"].contains("segmentation"));
-  EXPECT_NE(best_scene["description"].get<std::string>().find("column_left " +
-                                                             std::to_string(chosen[0])),
-            std::string::npos);
+  EXPECT_NE(
+      best_scene["description"].get<std::string>().find("column_left " + std::to_string(chosen[0])),
+      std::string::npos);
   for (const char* r : {"f1", "mass", "sway", "stress"}) {
     SCOPED_TRACE(r);
     EXPECT_EQ(again["responses"][r], best["responses"][r]);

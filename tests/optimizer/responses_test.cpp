@@ -158,7 +158,8 @@ TEST(Responses, BadExpressionsMassesAndLinksAreRefusedWithTheirPointers) {
   // An assignment wrote into the response it named ("dy = dy * 100": dy reported 100 times its
   // value, status ok; an adversarial review, 2026-12-01), and several results gave the last.
   doc["responses"]["e"]["expression"] = "dy = dy * 100";
-  expect_refused(doc, "/responses/e/expression", "an assignment (\"=\") would write into a response");
+  expect_refused(doc, "/responses/e/expression",
+                 "an assignment (\"=\") would write into a response");
   doc["responses"]["e"]["expression"] = "dy, 2 * dy";
   expect_refused(doc, "/responses/e/expression", "2 results separated by commas");
   doc["responses"]["e"]["expression"] = "f + 1";

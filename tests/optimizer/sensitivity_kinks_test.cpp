@@ -67,9 +67,10 @@ TEST(SensitivityKinks, AModeRepeatedWithOneNotAskedForGrowsAlongItsLowerBranch) 
   const double step = 1e-7;
   const double up = (evaluator.evaluate({w + step}).responses[0] - f) / step;
   const double down = (f - evaluator.evaluate({w - step}).responses[0]) / step;
-  std::printf("square tip, one mode: d f1/dw %.10e; closed form f/(2w) %.10e; forward %.10e, "
-              "backward %.10e (3 f/(2w) %.10e)\n",
-              s.jacobian(0, 0), f / (2 * w), up, down, 3 * f / (2 * w));
+  std::printf(
+      "square tip, one mode: d f1/dw %.10e; closed form f/(2w) %.10e; forward %.10e, "
+      "backward %.10e (3 f/(2w) %.10e)\n",
+      s.jacobian(0, 0), f / (2 * w), up, down, 3 * f / (2 * w));
   EXPECT_NEAR(s.jacobian(0, 0) / (f / (2 * w)), 1.0, 1e-10);
   EXPECT_NEAR(up / s.jacobian(0, 0), 1.0, 1e-4);
   EXPECT_NEAR(down / (3 * f / (2 * w)), 1.0, 1e-4);  // the other branch: a kink
@@ -106,9 +107,10 @@ TEST(SensitivityKinks, ABucklingFactorRepeatedWithOneNotAskedForGrowsAlongItsLow
   const double step = 1e-8;
   const double up = (evaluator.evaluate({w + step}).responses[0] - lambda) / step;
   const double down = (lambda - evaluator.evaluate({w - step}).responses[0]) / step;
-  std::printf("square column, one factor: d lambda/dw %.10e; closed form lambda/w %.10e; "
-              "forward %.10e, backward %.10e (3 lambda/w %.10e)\n",
-              s.jacobian(0, 0), lambda / w, up, down, 3 * lambda / w);
+  std::printf(
+      "square column, one factor: d lambda/dw %.10e; closed form lambda/w %.10e; "
+      "forward %.10e, backward %.10e (3 lambda/w %.10e)\n",
+      s.jacobian(0, 0), lambda / w, up, down, 3 * lambda / w);
   EXPECT_NEAR(s.jacobian(0, 0) / (lambda / w), 1.0, 1e-9);
   EXPECT_NEAR(up / s.jacobian(0, 0), 1.0, 1e-4);
   EXPECT_NEAR(down / (3 * lambda / w), 1.0, 1e-4);
@@ -141,9 +143,10 @@ TEST(SensitivityKinks, AStressWhoseMomentIsZeroGrowsEitherWay) {
   const double stress = at.responses[0], step = 1e-6;
   const double up = (evaluator.evaluate({step}).responses[0] - stress) / step;
   const double down = (stress - evaluator.evaluate({-step}).responses[0]) / step;
-  std::printf("turned section: stress %.10e Pa, d stress/dp %.10e; forward %.10e, backward "
-              "%.10e\n",
-              stress, s.jacobian(0, 0), up, down);
+  std::printf(
+      "turned section: stress %.10e Pa, d stress/dp %.10e; forward %.10e, backward "
+      "%.10e\n",
+      stress, s.jacobian(0, 0), up, down);
   ASSERT_GT(up, 0.0);
   EXPECT_NEAR(down / up, -1.0, 1e-3);  // V-shaped
   EXPECT_NEAR(s.jacobian(0, 0) / up, 1.0, 1e-3);
@@ -154,9 +157,9 @@ TEST(SensitivityKinks, AStressWhoseMomentIsZeroGrowsEitherWay) {
   const double p = 0.05;
   const DesignOutcome turned = evaluator.evaluate({p}, &off);
   ASSERT_EQ(turned.status, Status::kOk) << turned.message;
-  const double central = (evaluator.evaluate({p + step}).responses[0] -
-                          evaluator.evaluate({p - step}).responses[0]) /
-                         (2 * step);
+  const double central =
+      (evaluator.evaluate({p + step}).responses[0] - evaluator.evaluate({p - step}).responses[0]) /
+      (2 * step);
   std::printf("at p = 0.05: d stress/dp %.10e, central differences %.10e\n", off.jacobian(0, 0),
               central);
   EXPECT_NEAR(off.jacobian(0, 0) / central, 1.0, 1e-5);
@@ -221,7 +224,8 @@ TEST(SensitivityKinks, AnExpressionAtAKinkTakesTheSlopeAsTheVariableGrows) {
   Diagnostics diag;
   const auto plain = load(R"({"name": "dy", )" + scene + R"(
     "responses": {"dy": {"quantity": "displacement", "body": "tip", "direction": [0, -1, 0]}},
-    )" + variables, diag);
+    )" + variables,
+                          diag);
   ASSERT_TRUE(plain) << diag.format();
   const double dy = DesignEvaluator(*plain).evaluate({3.0}).responses[0], f = 3.0;
   char c[32];
@@ -229,10 +233,13 @@ TEST(SensitivityKinks, AnExpressionAtAKinkTakesTheSlopeAsTheVariableGrows) {
   const std::string tie = c;
   const auto study = load(R"({"name": "kinks", )" + scene + R"x(
     "responses": {"dy": {"quantity": "displacement", "body": "tip", "direction": [0, -1, 0]},
-                  "upper": {"quantity": "expression", "expression": "max(dy, )x" + tie + R"x()"},
-                  "lower": {"quantity": "expression", "expression": "min(dy, )x" + tie + R"x()"},
+                  "upper": {"quantity": "expression", "expression": "max(dy, )x" +
+                              tie + R"x()"},
+                  "lower": {"quantity": "expression", "expression": "min(dy, )x" +
+                              tie + R"x()"},
                   "square": {"quantity": "expression", "expression": "dy^2"}},
-    )x" + variables, diag);
+    )x" + variables,
+                          diag);
   ASSERT_TRUE(study) << diag.format();
   const DesignEvaluator evaluator(*study);
   ResponseSensitivities s;
@@ -250,10 +257,11 @@ TEST(SensitivityKinks, AnExpressionAtAKinkTakesTheSlopeAsTheVariableGrows) {
             square = index("square");
   ASSERT_EQ(at.responses[upper], dy);
   ASSERT_EQ(at.responses[lower], dy);
-  std::printf("dy %.10e: d dy/dF %.10e (dy/F %.10e); d max/dF %.10e, d min/dF %.10e, "
-              "d dy^2/dF %.10e (2 dy^2/F %.10e)\n",
-              dy, s.jacobian(y, 0), dy / f, s.jacobian(upper, 0), s.jacobian(lower, 0),
-              s.jacobian(square, 0), 2 * dy * dy / f);
+  std::printf(
+      "dy %.10e: d dy/dF %.10e (dy/F %.10e); d max/dF %.10e, d min/dF %.10e, "
+      "d dy^2/dF %.10e (2 dy^2/F %.10e)\n",
+      dy, s.jacobian(y, 0), dy / f, s.jacobian(upper, 0), s.jacobian(lower, 0),
+      s.jacobian(square, 0), 2 * dy * dy / f);
   EXPECT_NEAR(s.jacobian(y, 0) / (dy / f), 1.0, 1e-5);  // the geometric nonlinearity: ~(dy/L)^2
   EXPECT_NEAR(s.jacobian(upper, 0) / s.jacobian(y, 0), 1.0, 1e-6);
   EXPECT_NEAR(s.jacobian(lower, 0), 0.0, 1e-6 * s.jacobian(y, 0));

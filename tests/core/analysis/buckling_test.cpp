@@ -112,8 +112,8 @@ TEST(Buckling, LoadsBeyondDoublePrecisionFailAndSaySo) {
   EXPECT_NEAR(large.modes[0].factor * 1e100 / (small.modes[0].factor * 100.0), 1.0, 1e-12);
   for (double load : {1e200, 1e300}) {
     const BucklingResult r = buckle(cantilever_column(16, load).model(), "");
-    std::printf("%g N: ok %d, %s, %zu factors (%g), %zu warnings %s\n", load, r.ok, r.message.c_str(),
-                r.modes.size(), r.modes.empty() ? 0.0 : r.modes[0].factor * load,
+    std::printf("%g N: ok %d, %s, %zu factors (%g), %zu warnings %s\n", load, r.ok,
+                r.message.c_str(), r.modes.size(), r.modes.empty() ? 0.0 : r.modes[0].factor * load,
                 r.warnings.size(), r.warnings.empty() ? "" : r.warnings[0].c_str());
     EXPECT_FALSE(r.ok);
     EXPECT_NE(r.message.find("beyond double precision"), std::string::npos) << r.message;

@@ -152,9 +152,8 @@ TEST(SensitivityCore, ScaledRigiditiesAndMassesHaveTheirClosedFormDerivatives) {
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(k, m);
   const std::vector<double> lambdas(eig.eigenvalues().data(),
                                     eig.eigenvalues().data() + eig.eigenvalues().size());
-  const EigenvalueDerivatives by_rigidity =
-      eigenvalue_derivatives(model, rest, {&rigidity}, {}, 0.0, 1.0, lambdas, eig.eigenvectors(),
-                             true);
+  const EigenvalueDerivatives by_rigidity = eigenvalue_derivatives(
+      model, rest, {&rigidity}, {}, 0.0, 1.0, lambdas, eig.eigenvectors(), true);
   const Model heavier = scaled(model, 1 + h, false), lighter = scaled(model, 1 - h, false);
   const DualModel mass = design_direction(model, heavier, lighter, h);
   const EigenvalueDerivatives by_mass =

@@ -482,6 +482,18 @@ std::optional<ModelT<S>> build_scene(const Json& scene, const Where& where, Diag
 
   if (diag.size() > errors_before) return std::nullopt;
 
+  // Gravity times a body's mass can overflow where each is finite (a gravity of 1e308 failed at
+  // run time, "loads out of the range of double precision", exit 1; an adversarial review).
+  for (const BodyT<S>& b : model.bodies)
+    if (!b.fixed && !(values_of(Vec3T<S>(Vec3T<S>::Constant(b.mass))).cwiseProduct(
+                          values_of(model.gravity)))
+                         .allFinite()) {
+      diag.error(where.file, (where / "gravity").pointer,
+                 "gravity times the mass of body \"" + b.name +
+                     "\" is out of the range of double precision (not finite)");
+      return std::nullopt;
+    }
+
   for (size_t k = 0; k < specs.loads.size(); ++k) {
     LoadT<S> load = specs.loads[k];
     const BodyT<S>& b = model.bodies[load.body];

@@ -127,6 +127,22 @@ TEST(LoaderFindings, ElementStiffnessOrGeometryThatOverflows) {
             "(their squared distances overflow)\n");
 }
 
+// Gravity of 1e308 on a 10 kg body: its weight overflows. It failed at run time (exit 1, "loads out
+// of the range of double precision"); it is bad input (an adversarial review, 2026-12-01).
+TEST(LoaderFindings, GravityTimesAMassThatOverflows) {
+  nlohmann::json s = base_study();
+  s["scene"]["bodies"][0]["mass"] = 10;
+  s["scene"]["gravity"] = {0, 0, 1e308};
+  const std::string p = problems(s);
+  EXPECT_NE(p.find("finding.json:/scene/gravity: gravity times the mass of body \""),
+            std::string::npos)
+      << p;
+  EXPECT_NE(p.find("is out of the range of double precision (not finite)"), std::string::npos)
+      << p;
+  s["scene"]["gravity"] = {0, 0, 1e300};  // 1e301 N: finite
+  EXPECT_EQ(problems(s), "");
+}
+
 TEST(LoaderFindings, LoadPointFarFromItsBody) {
   nlohmann::json s = base_study();
   s["scene"]["bodies"][0]["position"] = {-1e308, 0, 0};

@@ -485,9 +485,7 @@ std::optional<ModelT<S>> build_scene(const Json& scene, const Where& where, Diag
   // Gravity times a body's mass can overflow where each is finite (a gravity of 1e308 failed at
   // run time, "loads out of the range of double precision", exit 1; an adversarial review).
   for (const BodyT<S>& b : model.bodies)
-    if (!b.fixed && !(values_of(Vec3T<S>(Vec3T<S>::Constant(b.mass))).cwiseProduct(
-                          values_of(model.gravity)))
-                         .allFinite()) {
+    if (!b.fixed && !(value_of(b.mass) * values_of(model.gravity)).allFinite()) {
       diag.error(where.file, (where / "gravity").pointer,
                  "gravity times the mass of body \"" + b.name +
                      "\" is out of the range of double precision (not finite)");

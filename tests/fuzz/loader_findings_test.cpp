@@ -137,8 +137,7 @@ TEST(LoaderFindings, GravityTimesAMassThatOverflows) {
   EXPECT_NE(p.find("finding.json:/scene/gravity: gravity times the mass of body \""),
             std::string::npos)
       << p;
-  EXPECT_NE(p.find("is out of the range of double precision (not finite)"), std::string::npos)
-      << p;
+  EXPECT_NE(p.find("is out of the range of double precision (not finite)"), std::string::npos) << p;
   s["scene"]["gravity"] = {0, 0, 1e300};  // 1e301 N: finite
   EXPECT_EQ(problems(s), "");
 }

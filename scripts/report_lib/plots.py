@@ -182,6 +182,30 @@ def shapes(base, modes, path, name, label):
             "light: -) over the state linearized about (grey)")
 
 
+def sweep_points(rows, var, resp):
+    """One panel of a sweep's responses: (variable values, response values) of the ok rows
+    without warnings ("ok"), of those with ("warned"), of the others with a value ("failed": a
+    design that failed after this response was computed), and the variable values of the rows
+    without this response ("no_value")."""
+    def value(r, col):
+        try:
+            return float(r[col])
+        except (TypeError, ValueError):
+            return math.nan
+
+    out = {"ok": ([], []), "warned": ([], []), "failed": ([], []), "no_value": []}
+    for r in rows:
+        x, y = value(r, var), value(r, resp)
+        if not math.isfinite(y):
+            out["no_value"].append(x)
+            continue
+        kind = ("failed" if r["status"] != "ok" else
+                "warned" if int(r["warnings"]) > 0 else "ok")
+        out[kind][0].append(x)
+        out[kind][1].append(y)
+    return out
+
+
 def sweep(rows, variables, responses, units, path_responses, path_pairs, name):
     """rows: samples.csv as dicts. Each response against each variable; a pairwise view of the
     variables (2 to 4 of them) coloured by the first response."""
@@ -195,25 +219,31 @@ def sweep(rows, variables, responses, units, path_responses, path_pairs, name):
     fig, axes = plt.subplots(len(shown_r), len(shown_v), figsize=(3.4 * len(shown_v) + 0.8,
                                                                    2.6 * len(shown_r) + 0.6),
                              squeeze=False)
+    legend = {}
     for i, resp in enumerate(shown_r):
         for j, var in enumerate(shown_v):
             ax = axes[i, j]
-            finite = [float(r[resp]) for r in rows if math.isfinite(float(r[resp]))]
-            floor = min(finite) if finite else 0.0
-            if ok:
-                ax.plot(values(var, ok), values(resp, ok), "o", ms=4, color="#1f77b4",
-                        label="ok (feasible)")
-            if warned:
-                ax.plot(values(var, warned), values(resp, warned), "s", ms=4, color="#ff7f0e",
-                        label="ok with warnings")
-            if failed:
-                ax.plot(values(var, failed), [floor] * len(failed), "x", ms=6, color="#d62728",
-                        label="failed, invalid or timeout (no value)")
+            points = sweep_points(rows, var, resp)
+            if len(points["ok"][0]):
+                ax.plot(*points["ok"], "o", ms=4, color="#1f77b4", label="ok")
+            if len(points["warned"][0]):
+                ax.plot(*points["warned"], "s", ms=4, color="#ff7f0e", label="ok with warnings")
+            if len(points["failed"][0]):
+                ax.plot(*points["failed"], "x", ms=6, color="#d62728",
+                        label="failed, invalid or timeout")
+            if len(points["no_value"]):
+                # Rows without this response: on the x axis itself (axes coordinates), so that
+                # no mark sits at a value another design has.
+                ax.plot(points["no_value"], [0.0] * len(points["no_value"]), "x", ms=6,
+                        color="#7f7f7f", clip_on=False, transform=ax.get_xaxis_transform(),
+                        label="no value (on the x axis)")
             ax.set_xlabel(f"{var} [{units.get(var, '-')}]", fontsize=8)
             ax.set_ylabel(f"{resp} [{units.get(resp, '-')}]", fontsize=8)
             ax.tick_params(labelsize=7)
             ax.grid(True, alpha=0.3)
-    handles, labels = axes[0, 0].get_legend_handles_labels()
+            for h, label in zip(*ax.get_legend_handles_labels()):
+                legend.setdefault(label, h)
+    handles, labels = list(legend.values()), list(legend)
     top = 1 - 0.75 / fig.get_figheight()
     fig.suptitle(f"{name}: each response against each variable", y=0.995, fontsize=10)
     fig.legend(handles, labels, loc="upper center", ncol=3, fontsize=8,

@@ -26,7 +26,7 @@ MAX_VIEW_BYTES = 40e6
 
 RESPONSE_UNITS = {"frequency": "Hz", "buckling_factor": "-", "displacement": "m",
                   "rotation": "rad", "peak_displacement": "m", "mass": "kg", "max_stress": "Pa",
-                  "expression": "-"}
+                  "joint_gap": "m", "expression": "-"}
 
 
 class BadInput(Exception):
@@ -107,7 +107,7 @@ def pointer_unit(pointer, loads):
              "point2": "m", "point3": "m", "velocity": "m/s", "angular_velocity": "rad/s",
              "damping": "s", "min_length": "m", "travel": "m", "segments": "-", "at": "s",
              "from": "s", "to": "s", "frequency": "Hz", "phase": "rad", "t_end": "s",
-             "output_step": "s", "time": "s"}
+             "output_step": "s", "time": "s", "max_frequency_hz": "Hz"}
     return table.get(last, "-")
 
 
@@ -192,11 +192,14 @@ def view_of(results, entry, prefix):
 
 
 def force_colours(axial):
-    """Red for tension, blue for compression, grey for none, by |N| over the largest."""
-    top = float(np.abs(axial).max()) if len(axial) else 0.0
+    """Red for tension, blue for compression, grey for none, by |N| over the largest. A joint's
+    axial force is NaN in the VTK files (it has none): grey, and not part of the largest."""
+    magnitudes = np.abs(np.asarray(axial, dtype=float))
+    finite = magnitudes[np.isfinite(magnitudes)]
+    top = float(finite.max()) if len(finite) else 0.0
     out = []
     for n in axial:
-        s = abs(n) / top if top > 0 else 0.0
+        s = abs(n) / top if top > 0 and math.isfinite(n) else 0.0
         end = (0.84, 0.15, 0.16) if n > 0 else (0.12, 0.47, 0.71)
         out.append([round(0.55 + s * (c - 0.55), 3) for c in end])
     return out

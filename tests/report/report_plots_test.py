@@ -90,5 +90,48 @@ class Plots(support.TempDir):
         self.assertRegex(err, re.escape("summary.json cannot be read"))
 
 
+class Pieces(unittest.TestCase):
+    """The report's own computations on data made for them (an adversarial review, 2026-12-01)."""
+
+    @classmethod
+    def setUpClass(cls):
+        sys.path.insert(0, os.path.join(support.SOURCE, "scripts", "report_lib"))
+        import plots
+        import report
+        cls.plots, cls.report = plots, report
+
+    def test_a_joint_leaves_the_beams_their_force_colours(self):
+        # A joint's axial force is NaN in the VTK files: it turned every element grey (no force)
+        # where the page promises red for tension and blue for compression.
+        nan = float("nan")
+        colours = self.report.force_colours([2468.0, nan, -1234.0, 0.0])
+        self.assertEqual(colours[0], [0.84, 0.15, 0.16])  # the largest tension: full red
+        self.assertEqual(colours[1], [0.55, 0.55, 0.55])  # the joint: grey
+        self.assertEqual(colours[2], [round(0.55 + 0.5 * (c - 0.55), 3)
+                                      for c in (0.12, 0.47, 0.71)])  # half the largest
+        self.assertEqual(colours[3], [0.55, 0.55, 0.55])
+
+    def test_units_of_a_joint_gap_and_a_segmentation_target(self):
+        units = self.report.units_of({
+            "responses": {"gap": {"quantity": "joint_gap"}},
+            "study": {"variables": [{"name": "band",
+                                     "pointer": "/scene/segmentation/max_frequency_hz"}]}})
+        self.assertEqual(units, {"gap": "m", "band": "Hz"})
+
+    def test_a_sweep_draws_each_design_at_its_own_value(self):
+        # A failed row that has the response is drawn at its value (it was drawn at the smallest
+        # value of the panel, another design's); one without it sits on the x axis.
+        rows = [{"status": "ok", "warnings": "0", "r": "1.0", "m": "3.2663"},
+                {"status": "ok", "warnings": "2", "r": "2.0", "m": "3.4"},
+                {"status": "failed", "warnings": "0", "r": "3.0", "m": "3.5919"},
+                {"status": "invalid", "warnings": "0", "r": "4.0", "m": "nan"},
+                {"status": "timeout", "warnings": "0", "r": "5.0", "m": ""}]
+        p = self.plots.sweep_points(rows, "r", "m")
+        self.assertEqual(p["ok"], ([1.0], [3.2663]))
+        self.assertEqual(p["warned"], ([2.0], [3.4]))
+        self.assertEqual(p["failed"], ([3.0], [3.5919]))
+        self.assertEqual(p["no_value"], [4.0, 5.0])
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)

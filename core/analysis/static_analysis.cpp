@@ -41,12 +41,21 @@ struct Stability {
 // beyond, the kNearStabilityCount nearest zero (Arnoldi), where loads move eigenvalues across
 // zero or make two of them meet, and the sign of det K (an odd number of negative ones anywhere).
 constexpr Eigen::Index kDenseStabilityLimit = 120;
+// The imaginary part below which an eigenvalue is real, in multiples of kEps times the largest
+// stiffness over mass: the absolute rounding of the computed eigenvalues (count_unstable).
+constexpr double kStabilityNoise = 100.0;
 constexpr Eigen::Index kNearStabilityCount = 12;
 
-void count_unstable(const Eigen::VectorXcd& values, double mu, Stability& result) {
+// An eigenvalue's imaginary part counts as flutter beyond 1e-6 of its size and beyond `noise`,
+// the rounding of the whole problem's eigenvalues (a multiple of kEps times the largest
+// stiffness over mass): a hanging chain of three on spherical joints has three spins without
+// stiffness, shifted to mu, whose rounding (eigenvalues mu +- 2e-9 i where mu = 5.2e-4 and
+// kEps times the largest stiffness over mass is 5.2e-8) read as a growing pair and failed its
+// static analysis as unstable (found 2026-12-01).
+void count_unstable(const Eigen::VectorXcd& values, double mu, double noise, Stability& result) {
   for (Eigen::Index i = 0; i < values.size(); ++i) {
     const double size = std::max(std::abs(values(i)), mu);
-    if (std::abs(values(i).imag()) > 1e-6 * size)
+    if (std::abs(values(i).imag()) > std::max(1e-6 * size, noise))
       result.flutter += values(i).imag() > 0.0;
     else
       result.negative += values(i).real() < 0.0;
@@ -59,13 +68,12 @@ Stability stability(const Model& model, Data& data, double t) {
   Eigen::SparseMatrix<double> k =
       symmetric_stiffness(model, data, stiffness_weights(model, data), &asymmetry);
   const Eigen::SparseMatrix<double> m = mass_matrix(model, data);
-  double mu = 0.0;
-  if (!held_by_beams(model)) {
-    double scale = 0.0;
-    for (Eigen::Index i = 0; i < k.rows(); ++i)
-      scale = std::max(scale, std::abs(k.coeff(i, i)) / m.coeff(i, i));
-    mu = 1e4 * kEps * (scale > 0.0 ? scale : 1.0);
-  }
+  double scale = 0.0;  // the largest stiffness over mass [1/s^2]
+  for (Eigen::Index i = 0; i < k.rows(); ++i)
+    scale = std::max(scale, std::abs(k.coeff(i, i)) / m.coeff(i, i));
+  if (!(scale > 0.0 && std::isfinite(scale))) scale = 1.0;
+  const double mu = held_by_beams(model) ? 0.0 : 1e4 * kEps * scale;
+  const double noise = kStabilityNoise * kEps * scale;
   Stability result;
   if (asymmetry <= kModalAsymmetryLimit) {
     k += mu * m;
@@ -84,7 +92,7 @@ Stability stability(const Model& model, Data& data, double t) {
     if (!solve_dense_nonsymmetric(Eigen::MatrixXd(full), Eigen::MatrixXd(m), values))
       result.negative = 1;
     else
-      count_unstable(values, mu, result);
+      count_unstable(values, mu, noise, result);
     return result;
   }
   // K + mu M: the shift moves rigid directions off zero; the eigenvalues nearest 0.
@@ -92,7 +100,7 @@ Stability stability(const Model& model, Data& data, double t) {
     result.negative = 1;
     return result;
   }
-  count_unstable(values, mu, result);
+  count_unstable(values, mu, noise, result);
   if (result.negative == 0) {
     full.makeCompressed();
     Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(full);

@@ -144,6 +144,24 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
         if (v->fixed_step > 0.0) j["verification"]["fixed_step"] = v->fixed_step;
         if (v->max_step > 0.0) j["verification"]["max_step"] = v->max_step;
       }
+      if (const auto& r = a.refinement) {
+        const Verification& f = r->first_run;
+        j["refinement"] = {
+            {"reason",
+             "the run at the tolerances asked was more than 10 times its tolerance off its "
+             "verification rerun; the results, steps and verification reported are those of "
+             "the run at the rerun's tolerances"},
+            {"rtol", f.rtol},
+            {"atol", f.atol},
+            {"first_run",
+             {{"error", json_number(f.error)},
+              {"rotation_error", json_number(f.rotation_error)},
+              {"tolerances", json_number(f.tolerances)},
+              {"rotation_tolerances", json_number(f.rotation_tolerances)},
+              {"steps", r->first_stats.steps},
+              {"wall_seconds", r->first_stats.wall_seconds},
+              {"verification_wall_seconds", f.stats.wall_seconds}}}};
+      }
     }
     if (a.statics) {
       const StaticResult& r = *a.statics;

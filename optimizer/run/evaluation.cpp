@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <memory>
@@ -289,31 +290,113 @@ class Runner {
       initial_state_at(model, *e.data, options.initial_state.data());
       options.max_seconds = budget_left(spec.transient.max_seconds);
     }
-    Data data(model);
     std::vector<std::pair<size_t, PointTracker>> peaks;
     for (size_t k = 0; k < study_.responses.size(); ++k)
       if (study_.responses[k].quantity == ResponseSpec::Quantity::kPeakDisplacement &&
-          study_.responses[k].analysis == index) {
+          study_.responses[k].analysis == index)
         peaks.emplace_back(k, PointTracker(model, study_.responses[k]));
-        ev_.responses[k] = 0.0;
-      }
-    if (options_.vtk && !options_.vtk->begin_series(spec.name, model, &report.message)) return;
-    TransientSink* const table = options_.timeseries;
-    std::string table_error;
-    const std::string file = table_file(spec, "timeseries.csv");
-    if (table && !table->begin(file, model, &table_error)) {
-      report.message = table_error;
-      return;
-    }
-    if (table) report.tables = {file};
-
     std::string verification = verification_reason(spec, model, options);
     // auto may yet relinearize or hand a phase to bdf (verified_after_the_run): the trajectory
     // is kept.
     const bool verify = !verification.empty() || may_verify_after_the_run(spec, options);
-    Trajectory trajectory = trajectory_of(model, output_rows(options));
+    // The run, then (refine_transient) at most once more at the verification's tighter
+    // tolerances, which replaces it: its outputs, figures and warnings are the report's.
+    TransientOptions run_options = options;
+    std::vector<std::string> warnings;
+    for (;;) {
+      warnings.clear();
+      Trajectory trajectory = trajectory_of(model, output_rows(options));
+      EnergyScales energy;
+      std::string table_error;
+      bool floored = false;
+      const std::optional<TransientResult> streamed =
+          stream_transient(spec, model, run_options, peaks, report, energy,
+                           verify ? &trajectory : nullptr, &floored, &table_error);
+      if (!streamed) return;  // its outputs could not be begun (report.message says why)
+      const TransientResult& result = *streamed;
+      report.ok = result.ok;
+      report.timed_out = result.timed_out;
+      report.interrupted = result.interrupted;
+      report.message = result.message;
+      if (result.interrupted)
+        report.message = "interrupted at t = " + format_number(result.t_reached) + " s";
+      report.stats = result.stats;
+      report.integrator = method_name(run_options.integrator.method);
+      if (!run_options.integrator.table.empty())
+        report.integrator += " " + run_options.integrator.table;
+      report.linear_solver = result.linear_solver;
+      report.phases = result.phases;
+      report.phase_count = result.phase_count;
+      // The band integrated: chosen for rtol ("auto", or by auto on a large scene) or given.
+      report.max_frequency_hz = result.max_frequency_hz > 0.0
+                                    ? result.max_frequency_hz
+                                    : run_options.integrator.max_frequency_hz;
+      report.axial_force_effect = result.axial_force_effect;
+      report.axial_force_time = result.axial_force_time;
+      report.axial_force_states = result.axial_force_states;
+      report.axial_force_seconds = result.axial_force_seconds;
+      report.axial_force_unmeasured = result.axial_force_unmeasured;
+      report.wall_seconds = result.stats.wall_seconds;
+      report.t_reached = result.t_reached;
+      warnings = result.warnings;
+      if (!table_error.empty() && report.message.find(table_error) == std::string::npos) {
+        report.message = report.ok ? table_error : report.message + "; " + table_error;
+        report.ok = false;
+      }
+      if (!result.ok)
+        for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
+      // Weighed against the tolerances asked (options), also for a refined run.
+      if (report.ok && !(report.max_frequency_hz > 0.0) && !floored)
+        warnings.push_back(energy_drift_warning(spec, model, options, report.energy_max_change,
+                                                energy, result.stats.steps));
+      if (verification.empty())
+        verification = verified_after_the_run(spec, model, run_options, result);
+      report.verification.reset();
+      if (!report.ok || verification.empty()) break;
+      report.verification = rerun_tighter(model, run_options, trajectory, result.stats);
+      Verification& v = *report.verification;
+      v.reason = verification;
+      weigh_verification(options, &v);
+      if (stop_requested() && !v.ok) {
+        report.ok = false;
+        report.interrupted = true;
+        report.message = "interrupted in the verification rerun";
+        break;
+      }
+      if (report.refinement || !refine_transient(spec, result, report, &warnings)) {
+        warnings.push_back(verification_warning(spec, options, v, report.refinement));
+        break;
+      }
+      run_options.integrator.rtol = v.rtol;
+      run_options.integrator.atol = v.atol;
+      run_options.max_seconds = report.refinement->seconds_left;
+    }
+    add_warnings(warnings);
+  }
+
+  // One run of a transient streamed to its outputs: the time series, the VTK frames, the peak
+  // responses and the report's energy figures (energy: the scales its drift is weighed against),
+  // its bodies' samples kept in *trajectory when given; *floored: whether a rail reached its
+  // min_length. A second call (a refined run) replaces what the first wrote. Nothing, with the
+  // analysis failed, when its outputs cannot be begun.
+  std::optional<TransientResult> stream_transient(
+      const AnalysisSpec& spec, const Model& model, const TransientOptions& options,
+      std::vector<std::pair<size_t, PointTracker>>& peaks, AnalysisReport& report,
+      EnergyScales& energy, Trajectory* trajectory, bool* floored, std::string* table_error) {
+    report.ok = false;
+    if (options_.vtk && !options_.vtk->begin_series(spec.name, model, &report.message))
+      return std::nullopt;
+    TransientSink* const table = options_.timeseries;
+    const std::string file = table_file(spec, "timeseries.csv");
+    if (table && !table->begin(file, model, table_error)) {
+      report.message = *table_error;
+      return std::nullopt;
+    }
+    if (table) report.tables = {file};
+    for (auto& [k, t] : peaks) ev_.responses[k] = 0.0;
+    report.energy_initial = report.energy_final = report.energy_max_change = 0.0;
+    Data data(model);
     bool first = true;
-    EnergyScales energy;
     const auto observer = [&](const TransientSample& s, const Data& d) {
       if (first) report.energy_initial = s.energy(), first = false;
       energy.moving = std::max(energy.moving, s.kinetic + s.elastic);
@@ -326,59 +409,50 @@ class Runner {
         ev_.responses[k] = std::max(ev_.responses[k], std::abs(t.value(d)));
       if (table) table->sample(s, d);  // throws when it cannot be kept: the run fails
       if (options_.vtk) options_.vtk->frame(s.t, d);  // throws likewise
-      if (verify) trajectory.record(s, d);
+      if (trajectory) trajectory->record(s, d);
     };
-    const TransientResult result = run_transient(model, options, data, observer);
+    TransientResult result = run_transient(model, options, data, observer);
     report.energy_max_relative_change =
         report.energy_initial != 0.0 ? report.energy_max_change / std::abs(report.energy_initial)
                                      : kNaN;
-    if (table) table->end(&table_error);
-    if (options_.vtk && table_error.empty()) options_.vtk->end_series(&table_error);
-    report.ok = result.ok;
-    report.timed_out = result.timed_out;
-    report.interrupted = result.interrupted;
-    report.message = result.message;
-    if (result.interrupted)
-      report.message = "interrupted at t = " + format_number(result.t_reached) + " s";
-    report.stats = result.stats;
-    report.integrator = method_name(options.integrator.method);
-    if (!options.integrator.table.empty()) report.integrator += " " + options.integrator.table;
-    report.linear_solver = result.linear_solver;
-    report.phases = result.phases;
-    report.phase_count = result.phase_count;
-    // The band integrated: chosen for rtol ("auto", or by auto on a large scene) or given.
-    report.max_frequency_hz = result.max_frequency_hz > 0.0 ? result.max_frequency_hz
-                                                            : options.integrator.max_frequency_hz;
-    report.axial_force_effect = result.axial_force_effect;
-    report.axial_force_time = result.axial_force_time;
-    report.axial_force_states = result.axial_force_states;
-    report.axial_force_seconds = result.axial_force_seconds;
-    report.axial_force_unmeasured = result.axial_force_unmeasured;
-    report.wall_seconds = result.stats.wall_seconds;
-    report.t_reached = result.t_reached;
-    add_warnings(result.warnings);
-    if (!table_error.empty() && report.message.find(table_error) == std::string::npos) {
-      report.message = report.ok ? table_error : report.message + "; " + table_error;
-      report.ok = false;
+    if (table) table->end(table_error);
+    if (options_.vtk && table_error->empty()) options_.vtk->end_series(table_error);
+    *floored = rail_floored(data);
+    return result;
+  }
+
+  // Whether a verified run found off its tolerance is run again at its verification's tighter
+  // tolerances (rtol and atol / 10), its results replacing the run's ("refine", default true;
+  // docs/study_files.md "transient"): where its rerun found it more than kDriftTolerance times
+  // its tolerance off (the centres or the orientations) and the steps are adaptive, no stop was
+  // asked for, and the budget left holds the refined run and its own verification (three times
+  // the first rerun; else a warning says it was not refined). Records what the first run was in
+  // report.refinement.
+  bool refine_transient(const AnalysisSpec& spec, const TransientResult& run,
+                        AnalysisReport& report, std::vector<std::string>* warnings) {
+    const Verification& v = *report.verification;
+    if (!spec.refine || !v.ok || stop_requested() || spec.transient.integrator.fixed_step > 0.0 ||
+        !(v.tolerances > kDriftTolerance || v.rotation_tolerances > kDriftTolerance))
+      return false;
+    const double used = run.stats.wall_seconds + v.stats.wall_seconds;
+    const double own =
+        spec.transient.max_seconds > 0.0 ? std::max(1e-3, spec.transient.max_seconds - used) : 0.0;
+    const double left = budget_left(own);  // 0: no budget
+    if (left > 0.0 && left < 3.0 * v.stats.wall_seconds) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "not refined at rtol %.2g: the budget left (%.3g s of max_seconds) is less "
+                    "than three times its verification rerun's %.3g s",
+                    v.rtol, left, v.stats.wall_seconds);
+      warnings->push_back("transient \"" + spec.name + "\": " + text);
+      return false;
     }
-    if (!result.ok)
-      for (auto& [k, t] : peaks) ev_.responses[k] = kNaN;  // a partial peak is no peak
-    if (report.ok && !(report.max_frequency_hz > 0.0) && !rail_floored(data))
-      add_warnings({energy_drift_warning(spec, model, options, report.energy_max_change, energy,
-                                         result.stats.steps)});
-    if (verification.empty()) verification = verified_after_the_run(spec, model, options, result);
-    if (report.ok && !verification.empty()) {
-      report.verification = rerun_tighter(model, options, trajectory, result.stats);
-      report.verification->reason = verification;
-      weigh_verification(options, &*report.verification);
-      if (stop_requested() && !report.verification->ok) {
-        report.ok = false;
-        report.interrupted = true;
-        report.message = "interrupted in the verification rerun";
-      }
-      if (!report.interrupted)
-        add_warnings({verification_warning(spec, options, *report.verification)});
-    }
+    Refinement r;
+    r.first_run = v;
+    r.first_stats = run.stats;
+    r.seconds_left = left;
+    report.refinement = r;
+    return true;
   }
 
   // The output rows of a transient, its first state included.

@@ -56,7 +56,11 @@ struct AnalysisReport {
   double axial_force_effect = 0.0, axial_force_time = 0.0;
   int axial_force_states = 0, axial_force_unmeasured = 0;
   double axial_force_seconds = 0.0;
+  // Of the results reported (a refined run's, when it was refined).
   std::optional<Verification> verification;
+  // When the run was found off its tolerance and run again at its verification's tighter
+  // tolerances, whose results are the ones reported ("refine").
+  std::optional<Refinement> refinement;
   // static (also the equilibrium a modal or buckling analysis is linearized about, or that a
   // transient starts from)
   std::optional<StaticResult> statics;

@@ -169,8 +169,20 @@ void weigh_verification(const TransientOptions& options, Verification* v) {
 // tolerance (weigh_verification; "" when it is within it, or for a fixed step; a rerun that
 // failed warns that it measured nothing).
 std::string verification_warning(const AnalysisSpec& spec, const TransientOptions& options,
-                                 const Verification& v) {
+                                 const Verification& v,
+                                 const std::optional<Refinement>& refinement) {
   const double rtol = options.integrator.rtol;
+  // What was rerun: the run, or the refined run that replaced it.
+  std::string rerun = "the verification rerun";
+  if (refinement) {
+    const Verification& first = refinement->first_run;
+    rerun =
+        "its verification rerun found the run " +
+        two_digits(std::max(first.tolerances >= 0.0 ? first.tolerances : 0.0,
+                            first.rotation_tolerances >= 0.0 ? first.rotation_tolerances : 0.0)) +
+        " times its tolerance off, so it was run again at rtol " + two_digits(first.rtol) +
+        " (\"refine\"), and that run's verification rerun";
+  }
   if (!v.ok) {
     // A rerun that did not finish measured nothing (the run at rtol 1e-8 of a carriage with a
     // pendulum under a harmonic force: its rerun spent max_steps in 50 s, the run took 10 s).
@@ -178,7 +190,7 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
     // designs fit max_seconds_per_design but whose reruns do not warned on every row; an
     // adversarial review of bdf's verification, 2026-11-30).
     const bool unasked = spec.verify == AnalysisSpec::Verify::kAuto;
-    return "transient \"" + spec.name + "\": the verification rerun failed (" + v.message +
+    return "transient \"" + spec.name + "\": " + rerun + " failed (" + v.message +
            "): the run's error is not measured" +
            (unasked ? "; give it more max_seconds or max_steps, or \"verify\": false skips it"
                     : "");
@@ -203,6 +215,12 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
   // tolerances off over rtol 1e-4 .. 1e-10, growing as rtol shrinks; an adversarial review,
   // 2026-11-30), so for them another method is the other way out.
   const bool multistep_by_name = multistep(options.integrator.method);
+  if (refinement)
+    return "transient \"" + spec.name + "\": " + rerun + " at rtol " + two_digits(v.rtol) +
+           " moved " + what +
+           ": the results, those of the refined run, are not within the tolerance asked either; "
+           "run it at a smaller rtol" +
+           (multistep_by_name ? " or with another method (auto, dirk)" : "");
   return "transient \"" + spec.name + "\": the verification rerun at rtol / 10 moved " + what +
          ": the run is not within its tolerance; run it at a smaller rtol" +
          (multistep_by_name ? " or with another method (auto, dirk)" : "");

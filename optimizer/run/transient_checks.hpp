@@ -5,6 +5,7 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "core/analysis/transient.hpp"
@@ -35,6 +36,14 @@ struct Verification {
   double rotation_tolerances = std::numeric_limits<double>::quiet_NaN();
   SolverStats stats;   // of the tighter run
   std::string reason;  // why the run was verified: asked, or "verify": "auto"
+};
+
+// A transient run again at its verification's tighter tolerances, whose results replaced the
+// first run's ("refine"): what the first run was.
+struct Refinement {
+  Verification first_run;     // its verification (rtol, atol: the refined run's)
+  SolverStats first_stats;    // the first run's
+  double seconds_left = 0.0;  // given to the refined run and its verification [s]; 0: no budget
 };
 
 // How far past rtol an energy drift or a verification may go before the run warns: the
@@ -75,8 +84,10 @@ std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
 void weigh_verification(const TransientOptions& options, Verification* v);
 
 // The warning of a verification rerun farther from the run than kDriftTolerance times its
-// tolerance, or that failed.
+// tolerance, or that failed (options: as asked; refinement: what the run replaced, when it was
+// refined).
 std::string verification_warning(const AnalysisSpec& spec, const TransientOptions& options,
-                                 const Verification& v);
+                                 const Verification& v,
+                                 const std::optional<Refinement>& refinement = std::nullopt);
 
 }  // namespace beamrail

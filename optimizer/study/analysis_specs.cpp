@@ -102,6 +102,7 @@ bool read_transient(ObjectReader& r, AnalysisSpec& a) {
     else if (!(v->is_string() && v->get<std::string>() == "auto"))
       r.error("verify", "expected true, false or \"auto\"");
   }
+  if (const auto refine = r.boolean("refine", false)) a.refine = *refine;
   // The band integrated: a frequency [Hz], "output": half the output rate (what the samples
   // can show), or "auto": chosen for rtol. The integrator's own max_frequency_hz, when given,
   // wins.
@@ -288,9 +289,9 @@ std::optional<AnalysisSpec> read_analysis(const Json& value, const Where& where,
   const auto name = r.string("name", false);
   const auto load_case = r.string("load_case", false);
   if (!type) {
-    r.allow({"t_end", "output_step", "integrator", "verify", "max_seconds", "max_frequency_hz",
-             "time", "load_steps", "tolerance", "max_iterations", "modes", "about", "solver",
-             "initial", "control", "arc_length", "max_steps"});
+    r.allow({"t_end", "output_step", "integrator", "verify", "refine", "max_seconds",
+             "max_frequency_hz", "time", "load_steps", "tolerance", "max_iterations", "modes",
+             "about", "solver", "initial", "control", "arc_length", "max_steps"});
     return std::nullopt;
   }
   bool ok = true;

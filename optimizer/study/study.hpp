@@ -38,6 +38,9 @@ struct AnalysisSpec {
   // (verification_reason in optimizer/run/transient_checks.cpp says why).
   enum class Verify { kAuto, kAlways, kNever };
   Verify verify = Verify::kAuto;
+  // transient: a verified run found more than 10 times its tolerance off is run again at the
+  // verification's tighter tolerances, whose results replace it ("refine", default true).
+  bool refine = true;
   // transient: start at the static equilibrium of the loads at t = 0 (else: the scene's state)
   bool initial_static = false;
   Where where;

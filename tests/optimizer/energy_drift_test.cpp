@@ -99,9 +99,10 @@ class EnergyDrift : public testing::StudyRuns {
   // Runs the pair with `integrator` (and `verify`); its summary, and its error against the
   // reference.
   Json run_pair(const std::string& name, const Json& integrator, bool verify, double* error,
-                double t_end = 3.0) {
+                double t_end = 3.0, bool refine = true) {
     Json s = spinning_pair(integrator, t_end);
     if (verify) s["analyses"][0]["verify"] = true;
+    if (!refine) s["analyses"][0]["refine"] = false;
     run_ok(write_study(name + ".json", s), name);
     if (reference_.rows.empty()) {
       run_ok(
@@ -158,8 +159,8 @@ TEST_F(EnergyDrift, AVerificationFartherThanTenRtolWarnsWithItsFigure) {
   // Over 6 s the same run drifts to 55 rtol of the motion, beyond 10 times rtol + atol / motion
   // (its tolerance, 0.3 m of motion: 43 rtol), which the 3 s run (13 rtol) is not.
   double error = 0.0;
-  const Json s =
-      run_pair("verified", {{"method", "dirk"}, {"rtol", 1e-3}, {"atol", 1e-3}}, true, &error, 6.0);
+  const Json s = run_pair("verified", {{"method", "dirk"}, {"rtol", 1e-3}, {"atol", 1e-3}}, true,
+                          &error, 6.0, false);
   const Json& v = s["analyses"][0]["verification"];
   const std::vector<std::string> warned = warnings_of(s);
   const double quoted = figure_before(warned,
@@ -173,6 +174,26 @@ TEST_F(EnergyDrift, AVerificationFartherThanTenRtolWarnsWithItsFigure) {
   // The rerun's distance is an estimate of the run's own error (within a factor of 2 here).
   EXPECT_GT(v["error"].get<double>(), 0.5 * error);
   EXPECT_LT(v["error"].get<double>(), 2.0 * error);
+
+  // By default ("refine") such a run is run again at its rerun's tolerances, whose results
+  // replace it: within 10 times the tolerance asked against the reference, and no warning of it.
+  double refined_error = 0.0;
+  const Json r = run_pair("refined", {{"method", "dirk"}, {"rtol", 1e-3}, {"atol", 1e-3}}, true,
+                          &refined_error, 6.0);
+  const Json& a = r["analyses"][0];
+  ASSERT_TRUE(a.contains("refinement")) << r.dump(2);
+  std::printf(
+      "refined at rtol %.0e: %.3e against the reference (%.1f rtol asked), its "
+      "verification %.3e; %ld steps against the first run's %ld\n",
+      a["refinement"]["rtol"].get<double>(), refined_error, refined_error / 1e-3,
+      a["verification"]["error"].get<double>(), a["steps"].get<long>(),
+      a["refinement"]["first_run"]["steps"].get<long>());
+  EXPECT_DOUBLE_EQ(a["refinement"]["rtol"].get<double>(), 1e-4);
+  EXPECT_EQ(a["refinement"]["first_run"]["error"].get<double>(), v["error"].get<double>());
+  EXPECT_DOUBLE_EQ(a["verification"]["rtol"].get<double>(), 1e-5);
+  EXPECT_LT(refined_error, 10 * (1e-3 + 1e-3 / 0.3));
+  EXPECT_LT(refined_error, error / 5.0);
+  EXPECT_FALSE(has(warnings_of(r), "not within")) << r.dump(2);
 }
 
 // Where the energy need not be kept (a load does work, a beam is damped, the paper's law) the

@@ -59,9 +59,12 @@ Distance distance(const Table& run, const Table& reference) {
 class MultistepVerification : public testing::StudyRuns {
  protected:
   // Runs the damped tip with `integrator` and `verify` (absent when null): its summary, its table.
-  Json run_tip(const std::string& name, const Json& integrator, const Json& verify, Table* table) {
+  // With `refine` false the run is not run again where its verification finds it off.
+  Json run_tip(const std::string& name, const Json& integrator, const Json& verify, Table* table,
+               bool refine = true) {
     Json s = damped_tip(integrator);
     if (!verify.is_null()) s["analyses"][0]["verify"] = verify;
+    if (!refine) s["analyses"][0]["refine"] = false;
     run_ok(write_study(name + ".json", s), name);
     *table = read_table(dir_ / name / "ring.timeseries.csv");
     return load_json(dir_ / name / "summary.json");
@@ -79,7 +82,7 @@ TEST_F(MultistepVerification, BdfByNameVerifiesItselfAndWarnsWhereItIsOff) {
   EXPECT_FALSE(tight["analyses"][0].contains("verification")) << tight.dump(2);
   const double atol = 1e-14;
   const Json far =
-      run_tip("far", {{"method", "bdf"}, {"rtol", 1e-8}, {"atol", atol}}, nullptr, &off);
+      run_tip("far", {{"method", "bdf"}, {"rtol", 1e-8}, {"atol", atol}}, nullptr, &off, false);
   const Json& v = far["analyses"][0]["verification"];
   ASSERT_TRUE(v.is_object()) << far.dump(2);
   const Distance d = distance(off, reference);
@@ -106,6 +109,21 @@ TEST_F(MultistepVerification, BdfByNameVerifiesItselfAndWarnsWhereItIsOff) {
     other_method = other_method || w.get<std::string>().find(
                                        "or with another method (auto, dirk)") != std::string::npos;
   EXPECT_TRUE(other_method) << far.dump(2);
+  // By default ("refine") it is run again at rtol 1e-9, which is within the tolerance asked
+  // against the reference and says nothing of it.
+  Table refined;
+  const Json mended =
+      run_tip("refined", {{"method", "bdf"}, {"rtol", 1e-8}, {"atol", atol}}, nullptr, &refined);
+  const Distance r = distance(refined, reference);
+  const Json& m = mended["analyses"][0];
+  std::printf("refined: %.3g m off the reference (%.1f times the tolerance asked)\n", r.centres,
+              r.centres / tolerance);
+  ASSERT_TRUE(m.contains("refinement")) << mended.dump(2);
+  EXPECT_DOUBLE_EQ(m["refinement"]["rtol"].get<double>(), 1e-9);
+  EXPECT_EQ(m["refinement"]["first_run"]["tolerances"], v["tolerances"]);
+  EXPECT_LT(r.centres, 10.0 * tolerance);
+  EXPECT_LT(m["verification"]["tolerances"].get<double>(), 10.0);
+  EXPECT_FALSE(warns_off_tolerance(mended)) << mended.dump(2);
 
   const Json right =
       run_tip("loose", {{"method", "bdf"}, {"rtol", 1e-4}, {"atol", 1e-10}}, nullptr, &loose);

@@ -200,7 +200,8 @@ inline nlohmann::json tube_grid(const std::filesystem::path& studies, int n_d, i
 inline bool warns_off_tolerance(const nlohmann::json& summary) {
   if (!summary.contains("warnings")) return false;
   for (const nlohmann::json& w : summary["warnings"])
-    if (w.get<std::string>().find("the run is not within its tolerance") != std::string::npos)
+    if (w.get<std::string>().find("the run is not within its tolerance") != std::string::npos ||
+        w.get<std::string>().find("not within the tolerance asked") != std::string::npos)
       return true;
   return false;
 }

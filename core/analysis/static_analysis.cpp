@@ -44,6 +44,10 @@ constexpr Eigen::Index kDenseStabilityLimit = 120;
 // The imaginary part below which an eigenvalue is real, in multiples of kEps times the largest
 // stiffness over mass: the absolute rounding of the computed eigenvalues (count_unstable).
 constexpr double kStabilityNoise = 100.0;
+// The share of the load an equilibrium with directions solved minimum-norm may leave unbalanced
+// (studies/hinged_bob.json leaves 1.4e-5 of its load; the review's hinge 1e-2 times as compliant
+// left 0.75).
+constexpr double kMostUnbalancedShare = 1e-3;
 constexpr Eigen::Index kNearStabilityCount = 12;
 
 // An eigenvalue's imaginary part counts as flutter beyond 1e-6 of its size and beyond `noise`,
@@ -242,6 +246,37 @@ StaticResult solve_static(const Model& model, const StaticOptions& options, Data
           format("element forces (shear in very short segments) are uncertain by that much; the "
                  "displacements are converged (last correction %.2g of them)",
                  result.correction));
+    // A mechanism's last factorized tangent may be its unloaded start's: a pendulum started
+    // hanging converges in one Newton step, and its swing had no stiffness until its joint
+    // carried the bob (it warned "1 direction(s) without stiffness", a chain of three on
+    // spherical joints 9 where only its 3 spins are free). Its null directions are those of the
+    // equilibrium, counted again there.
+    if (result.ok && !newton.held && newton.last_singular > 0) {
+      compute_tangent(model, data, options.time, false, 1.0);
+      std::string why;
+      if (newton.solver.factorize(model, data, &why))
+        newton.last_singular = newton.solver.null_directions;
+      compute_wrenches(model, data, options.time, 1.0);
+    }
+    if (!newton.held) result.singular_directions = newton.last_singular;
+    // Directions the final tangent cannot tell from free ones take no part in the Newton
+    // corrections, so corrections that vanish say nothing of them; where rounding also leaves
+    // more than kMostUnbalancedShare of the load unbalanced, their displacements are not
+    // resolved. studies/hinged_bob.json with its hinge's relative_compliance at 1e-8 (a penalty
+    // 4e12 times the cantilever's stiffness) converged so with 0.75 of its load unbalanced: a tip
+    // that did not sag (5.8e-16 m for 0.028 m), the hinge's force of the wrong sign, and a modal
+    // analysis about that state, status ok (an adversarial review, 2026-12-01).
+    if (result.ok && newton.last_singular > 0 &&
+        result.residual_norm > kMostUnbalancedShare * f_ref) {
+      result.ok = false;
+      result.message =
+          format("rounding leaves %.3g N of the forces unbalanced (%.3g of the load) along ",
+                 result.residual_norm, result.residual_norm / f_ref) +
+          std::to_string(newton.last_singular) +
+          " direction(s) whose stiffness is below what the tangent resolves: the equilibrium is "
+          "beyond double precision (a structure far softer than its joints' or rails' penalty: "
+          "raise their relative_compliance)";
+    }
     if (newton.reported_singular() > 0)
       result.warnings.push_back(
           newton.held

@@ -82,7 +82,9 @@ struct StaticResult {
   double correction = 0.0;       // last Newton correction / largest displacement (both scaled)
   int iterations = 0;            // Newton iterations over all load steps
   int load_steps = 0;            // load increments taken
-  int singular_directions = 0;   // tangent directions with no stiffness (solved minimum-norm)
+  // Tangent directions with no stiffness (solved minimum-norm): a mechanism's at its
+  // equilibrium, a structure held by beams the most along its load path.
+  int singular_directions = 0;
   int negative_directions = 0;   // of the tangent at the equilibrium (> 0: unstable, not ok)
   int flutter_pairs = 0;  // growing vibration pairs under non-conservative loads (> 0: not ok)
   // Not ok because the loads push a free body or mechanism along a direction without stiffness

@@ -105,5 +105,84 @@ TEST(HangingChain, IsStableAndSwingsAsTheCompoundTriplePendulum) {
   }
 }
 
+// The directions without stiffness a mechanism's static analysis reports are those of its
+// equilibrium: the chain's three spins. A pendulum started hanging converges in one Newton step
+// from its unloaded tangent, where its swing had no stiffness yet: it warned of "1 direction(s)
+// without stiffness (a free mechanism)", and the chain of 9.
+TEST(HangingChain, ReportsTheDirectionsWithoutStiffnessOfItsEquilibrium) {
+  Diagnostics diag;
+  Json pendulum = chain();
+  pendulum["scene"]["bodies"] = Json::array({pendulum["scene"]["bodies"][0]});
+  pendulum["scene"]["joints"] = Json::array({pendulum["scene"]["joints"][0]});
+  pendulum["scene"]["joints"][0]["type"] = "revolute";
+  pendulum["scene"]["joints"][0]["axis"] = {0, 0, 1};
+  for (const auto& [doc, free] : {std::pair{chain(), 3}, std::pair{pendulum, 0}}) {
+    const auto s = load_study(doc, "hanging.json", ".", diag);
+    ASSERT_TRUE(s) << diag.format();
+    const Evaluation ev = evaluate(*s, s->model, EvaluationOptions{});
+    ASSERT_EQ(ev.status, Status::kOk) << ev.message;
+    ASSERT_TRUE(ev.analyses[0].statics);
+    EXPECT_EQ(ev.analyses[0].statics->singular_directions, free);
+    bool warned = false;
+    for (const std::string& w : ev.warnings)
+      warned = warned || w.find("direction(s) without stiffness") != std::string::npos;
+    EXPECT_EQ(warned, free > 0);
+    if (free > 0) {
+      const std::string count = "has " + std::to_string(free) + " direction(s)";
+      EXPECT_TRUE(std::any_of(ev.warnings.begin(), ev.warnings.end(), [&](const std::string& w) {
+        return w.find(count) != std::string::npos;
+      }));
+    }
+  }
+}
+
+// studies/hinged_bob.json (a 0.5 kg bob on a revolute joint at the tip of a 1 m steel
+// cantilever, 10 mm square) with its hinge's relative_compliance at 1e-8: the joint's penalty is
+// 4e12 times the cantilever's stiffness, below which the tangent resolves nothing. Its static
+// analysis converged with 7.36 N of its 9.81 N load unbalanced, a tip that did not sag (5.8e-16 m
+// for the closed form's 0.028 m), status ok. It fails now, saying why; at relative_compliance
+// 1e-4 it is the closed form (M + m) g L^3 / (3 E I) to 1e-6.
+TEST(HangingChain, AnEquilibriumBeyondDoublePrecisionFailsAndSaysWhy) {
+  const auto hinged_bob = [](const std::string& compliance) {
+    return Json::parse(R"({
+      "name": "hinged_bob",
+      "scene": {
+        "gravity": [0, -9.81, 0],
+        "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+        "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+        "bodies": [{"name": "tip", "mass": 1.0, "inertia": [1e-4, 1e-4, 1e-4], "position": [1, 0, 0]},
+                   {"name": "bob", "mass": 0.5, "inertia": [1e-3, 1e-3, 1e-3],
+                    "position": [1, -0.2, 0]}],
+        "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+                   "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel",
+                   "section": "sq10"}],
+        "joints": [{"name": "hinge", "type": "revolute", "body1": "tip", "body2": "bob",
+                    "point": [1, 0, 0], "axis": [0, 0, 1], "relative_compliance": )" +
+                       compliance + R"(}]
+      },
+      "analyses": [{"type": "static"}],
+      "responses": {"sag": {"quantity": "displacement", "body": "tip", "direction": [0, -1, 0]}}
+    })");
+  };
+  Diagnostics diag;
+  const auto stiff = load_study(hinged_bob("1e-8"), "stiff.json", ".", diag);
+  ASSERT_TRUE(stiff) << diag.format();
+  const Evaluation off = evaluate(*stiff, stiff->model, EvaluationOptions{});
+  EXPECT_EQ(off.status, Status::kFailed);
+  EXPECT_NE(off.message.find("of the forces unbalanced (0.75 of the load)"), std::string::npos)
+      << off.message;
+  EXPECT_NE(off.message.find("raise their relative_compliance"), std::string::npos) << off.message;
+  EXPECT_TRUE(std::isnan(off.responses[0]));
+  const auto soft = load_study(hinged_bob("1e-4"), "soft.json", ".", diag);
+  ASSERT_TRUE(soft) << diag.format();
+  const Evaluation right = evaluate(*soft, soft->model, EvaluationOptions{});
+  ASSERT_EQ(right.status, Status::kOk) << right.message;
+  const double inertia = 0.01 * 0.01 * 0.01 * 0.01 / 12.0;
+  const double sag = 1.5 * 9.81 / (3.0 * 2.1e11 * inertia);
+  std::printf("relative_compliance 1e-8: %s\n1e-4: sag %.9f m, closed form %.9f m\n",
+              off.message.c_str(), right.responses[0], sag);
+  EXPECT_NEAR(right.responses[0] / sag, 1.0, 1e-6);
+}
+
 }  // namespace
 }  // namespace beamrail

@@ -85,7 +85,7 @@ struct StaticResult {
   // Tangent directions with no stiffness (solved minimum-norm): a mechanism's at its
   // equilibrium, a structure held by beams the most along its load path.
   int singular_directions = 0;
-  int negative_directions = 0;   // of the tangent at the equilibrium (> 0: unstable, not ok)
+  int negative_directions = 0;  // of the tangent at the equilibrium (> 0: unstable, not ok)
   int flutter_pairs = 0;  // growing vibration pairs under non-conservative loads (> 0: not ok)
   // Not ok because the loads push a free body or mechanism along a direction without stiffness
   // (a carriage pushed along its rail): no equilibrium exists, whatever the load steps.

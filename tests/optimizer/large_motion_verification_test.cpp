@@ -94,6 +94,22 @@ Deviation deviation(const Table& run, const Table& reference) {
   return d;
 }
 
+// A deviation in multiples of its tolerance, as verify weighs it: the centres against
+// rtol x + atol (x the largest motion), the orientations against rtol max(turned, 1 rad) + atol.
+struct Weighed {
+  double centres = 0.0, orientations = 0.0;
+};
+
+Weighed weigh(const Deviation& d, double rtol, double atol) {
+  return {d.centres / (rtol * d.motion + atol), d.angle / (rtol * std::max(d.turned, 1.0) + atol)};
+}
+
+// The run `name`'s deviation from the reference run's.
+Deviation deviation_of(const std::filesystem::path& dir, const std::string& name) {
+  return deviation(read_table(dir / name / "swing.timeseries.csv"),
+                   read_table(dir / "reference/swing.timeseries.csv"));
+}
+
 class LargeMotionVerification : public testing::StudyRuns {};
 
 // At rtol 1e-5 (atol 9e-9) auto relinearizes hundreds of times and ends 21 times its tolerance off
@@ -114,10 +130,8 @@ TEST_F(LargeMotionVerification, AnAutoRunThatRelinearizesVerifiesItself) {
   const Json& a = summary["analyses"][0];
   const Json& v = a["verification"];
   ASSERT_TRUE(v.is_object()) << summary.dump(2);
-  const Deviation d = deviation(read_table(dir_ / "run/swing.timeseries.csv"),
-                                read_table(dir_ / "reference/swing.timeseries.csv"));
-  const double centres = d.centres / (rtol * d.motion + atol);
-  const double orientations = d.angle / (rtol * std::max(d.turned, 1.0) + atol);
+  const Deviation d = deviation_of(dir_, "run");
+  const auto [centres, orientations] = weigh(d, rtol, atol);
   std::printf(
       "%ld phases; against Verner at rtol 1e-10: centres %.3g m (%.1f times their tolerance), "
       "orientations %.3g rad (%.1f times; %.2f rad turned); the rerun: centres %.3g, "
@@ -147,10 +161,8 @@ TEST_F(LargeMotionVerification, AnAutoRunThatRelinearizesVerifiesItself) {
   const Json refined = load_json(dir_ / "refined/summary.json");
   const Json& r = refined["analyses"][0];
   ASSERT_TRUE(r.contains("refinement")) << refined.dump(2);
-  const Deviation e = deviation(read_table(dir_ / "refined/swing.timeseries.csv"),
-                                read_table(dir_ / "reference/swing.timeseries.csv"));
-  const double refined_centres = e.centres / (rtol * e.motion + atol);
-  const double refined_orientations = e.angle / (rtol * std::max(e.turned, 1.0) + atol);
+  const auto [refined_centres, refined_orientations] =
+      weigh(deviation_of(dir_, "refined"), rtol, atol);
   std::printf(
       "refined at rtol %.0e: centres %.1f and orientations %.1f times their tolerance against "
       "Verner; its rerun at %.0e: %.1f and %.1f\n",

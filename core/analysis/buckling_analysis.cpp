@@ -175,17 +175,28 @@ BucklingMatrices buckling_matrices(const Model& reference, const Model& scaled, 
         "check at the loads of interest");
   }
 
+  // With joints, a tangent that does not factorize or solve may be a held structure whose
+  // joints' penalty double precision cannot resolve against it: a column between revolute
+  // joints of relative_compliance 1e-9 was refused as "a body or mechanism free to move" (an
+  // adversarial review, 2026-12-01; at 1e-6 its factor is 1.013 times Euler's).
+  const std::string or_penalty =
+      reference.joints.empty()
+          ? ""
+          : "; or the joints' penalty stiffness is beyond what double precision resolves "
+            "against the structure (a relative_compliance far below the default 1e-6: raise it)";
   out.llt = std::make_shared<Eigen::SimplicialLLT<SparseMatrix>>(out.k0);
   if (out.llt->info() != Eigen::Success)
     throw std::runtime_error(
         "the reference state's tangent stiffness is not positive definite: a body or "
         "mechanism is free to move (a free body, or a carriage free along its rails), or the "
-        "constant loads already buckle the structure; buckling needs every body held");
+        "constant loads already buckle the structure; buckling needs every body held" +
+        or_penalty);
   const Eigen::VectorXd u1 = out.llt->solve(p1);
   if (!u1.allFinite() || !((out.k0 * u1 - p1).norm() <= 1e-6 * p1.norm()))
     throw std::runtime_error(
         "the reference state's tangent stiffness is singular (a body or mechanism free to "
-        "move): buckling needs every body held");
+        "move): buckling needs every body held" +
+        or_penalty);
 
   // Loads that move the structure by more than kMostMotionPerFactor per unit factor (a factor
   // below its inverse) overflow the stress stiffness's products in double precision: 1e200 N on a

@@ -8,7 +8,8 @@
 //   frequency twice (the swings in x and in z); the joints' penalty modes come after them;
 // - studies/hinged_bob.json's bob on a revolute joint at a cantilever's tip: its sag (M + m) g
 //   L^3 / (3 E I) and its swing sqrt(m g d / I_O) / 2 pi, and what a stiff joint's rounding does
-//   to them.
+//   to them;
+// - a column between revolute joints, pinned-pinned: Euler's buckling load.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -231,6 +232,62 @@ TEST(MechanismStatics, AStiffJointsRoundingIsWarnedWithItsSize) {
   EXPECT_NEAR(f[1] / closed, 1.0, 1e-5);
   EXPECT_GE(claimed, off);
   EXPECT_LE(claimed, 100.0 * off);
+}
+
+// A 1 m steel column of 10 mm square section in 16 segments between revolute joints about z, its
+// top on a slider guided along y by a prismatic rail and pushed down by 100 N: pinned-pinned, its
+// first buckling factor pi^2 E I / (L^2 100 N) x 1.0131 (the 16 segments' error,
+// docs/study_files.md "buckling"). With the joints at relative_compliance 1e-9 its tangent is
+// beyond double precision; the refusal said only "a body or mechanism free to move", where every
+// body is held.
+TEST(MechanismStatics, AColumnBetweenJointsBucklesAsEulersAndTooStiffJointsAreNamed) {
+  const auto column = [](const std::string& compliance) {
+    Json s = Json::parse(R"({
+      "name": "column",
+      "scene": {
+        "gravity": [0, 0, 0],
+        "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+        "sections": {"sq": {"shape": "rectangle", "width": 0.01, "height": 0.01},
+                     "rod20": {"shape": "circle", "diameter": 0.02}},
+        "bodies": [{"name": "bot", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5], "position": [0, 0, 0]},
+                   {"name": "top", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5], "position": [0, 1, 0]},
+                   {"name": "slider", "mass": 0.1, "inertia": [1e-5, 1e-5, 1e-5],
+                    "position": [0, 1, 0]}],
+        "beams": [{"name": "col", "body1": "bot", "body2": "top", "point1": [0, 0, 0],
+                   "point2": [0, 1, 0], "point3": [1, 0, 0], "material": "steel", "section": "sq",
+                   "segments": 16}],
+        "rails": [{"name": "guide", "type": "prismatic", "body1": "ground", "body2": "slider",
+                   "point1": [0, 2, 0], "point2": [0, 1, 0], "point3": [1, 2, 0],
+                   "material": "steel", "section": "rod20"}],
+        "joints": [{"name": "jb", "type": "revolute", "body1": "ground", "body2": "bot",
+                    "point": [0, 0, 0], "axis": [0, 0, 1]},
+                   {"name": "jt", "type": "revolute", "body1": "slider", "body2": "top",
+                    "point": [0, 1, 0], "axis": [0, 0, 1]}],
+        "loads": [{"type": "force", "body": "slider", "value": [0, -100, 0]}]
+      },
+      "analyses": [{"type": "buckling", "modes": 1}],
+      "responses": {"factor": {"quantity": "buckling_factor", "mode": 1}}
+    })");
+    for (Json& j : s["scene"]["joints"]) j["relative_compliance"] = std::stod(compliance);
+    return s;
+  };
+  Diagnostics diag;
+  const auto right = load_study(column("1e-6"), "column.json", ".", diag);
+  ASSERT_TRUE(right) << diag.format();
+  const Evaluation ev = evaluate(*right, right->model, EvaluationOptions{});
+  ASSERT_EQ(ev.status, Status::kOk) << ev.message;
+  const double euler = std::pow(std::numbers::pi, 2) * 2.1e11 * std::pow(0.01, 4) / 12.0 / 100.0;
+  std::printf("relative_compliance 1e-6: factor %.6f, %.5f times Euler's %.6f\n", ev.responses[0],
+              ev.responses[0] / euler, euler);
+  EXPECT_NEAR(ev.responses[0] / euler, 1.0131, 2e-4);
+  const auto stiff = load_study(column("1e-9"), "stiff.json", ".", diag);
+  ASSERT_TRUE(stiff) << diag.format();
+  const Evaluation refused = evaluate(*stiff, stiff->model, EvaluationOptions{});
+  EXPECT_EQ(refused.status, Status::kFailed);
+  EXPECT_NE(refused.message.find("the joints' penalty stiffness is beyond what double precision "
+                                 "resolves"),
+            std::string::npos)
+      << refused.message;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_matrix.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -38,9 +39,11 @@ struct OdeContext {
   // Wall-clock budget: past this moment the right-hand side fails unrecoverably.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
   bool timed_out = false;
-  bool interrupted = false;        // a stop was requested (stop_request.hpp)
+  bool interrupted = false;        // a stop was requested (stop_request.hpp) or cancel set
   long nonfinite_evaluations = 0;  // in the current call of the integrator
   std::string divergence;          // why the run was ended as diverged (non-finite forces)
+  // This run's own stop request (TransientOptions::cancel); nullptr: none.
+  const std::atomic<bool>* cancel = nullptr;
   // The last state of the current call with an element outside the range of its law (a
   // recoverable failure of the right-hand side), described: why the integrator gave up, if it
   // did so over failures of the right-hand side.
@@ -66,7 +69,7 @@ struct OdeContext {
 
   // True, with timed_out or interrupted set, when the run must end now.
   bool should_stop() {
-    if (stop_requested()) interrupted = true;
+    if (stop_requested() || (cancel && cancel->load(std::memory_order_relaxed))) interrupted = true;
     if (!interrupted && std::chrono::steady_clock::now() > deadline) timed_out = true;
     return interrupted || timed_out;
   }

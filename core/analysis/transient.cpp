@@ -235,6 +235,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     SundialsContext ctx;
     OdeContext context(model, data);
     context.structure_cache = options.structure_cache;
+    context.cancel = options.cancel;
     if (options.max_seconds > 0.0)
       context.deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                      std::chrono::duration<double>(options.max_seconds));

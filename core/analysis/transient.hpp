@@ -4,6 +4,7 @@
 // output step.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <optional>
 #include <string>
@@ -92,6 +93,9 @@ struct TransientOptions {
   // The state at t = 0 (dim model.n_states; initial_state_at makes one from a static
   // equilibrium); empty: the model's initial state.
   std::vector<double> initial_state;
+  // Set by another thread, it ends the run as interrupted at its next right-hand side (as a stop
+  // request does, stop_request.hpp, for this run alone); nullptr: none.
+  const std::atomic<bool>* cancel = nullptr;
 
   // Whether the options can run (t_end and output_step positive and finite, at most 1e8 output
   // steps, the integrator's options valid): true, or false with the first problem in *error.

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <new>
+#include <thread>
 
 #include "core/analysis/dense_product.hpp"
 #include "core/analysis/stop_request.hpp"
@@ -45,7 +46,9 @@ Options:
   -o, --output OUTDIR   where to write the results
   -j, --threads N       threads for batch evaluation, 1..1024 (default: all cores; never
                         more than the designs evaluated at once); a single run shares the
-                        modal method's dense products among them (default: one thread)
+                        modal method's dense products among them (default: one thread) and
+                        runs a transient's verification rerun beside the run on a second
+                        (default: when the machine has two cores; -j 1: after the run)
   --resume              continue an interrupted sweep or optimization in OUTDIR (refused
                         when OUTDIR's tables were written by another version of the study)
   --quiet               no progress output
@@ -183,9 +186,10 @@ std::string resumable_table(const Study& study) {
   return "";
 }
 
-int run_single(const Study& study, const std::filesystem::path& out, bool vtk) {
+int run_single(const Study& study, const std::filesystem::path& out, bool vtk, bool verify_beside) {
   EvaluationOptions options;
   options.result_tables = true;
+  options.verify_beside = verify_beside;
   TimeseriesFiles timeseries(out);
   options.timeseries = &timeseries;
   std::optional<VtkOutput> vtk_output;
@@ -311,7 +315,11 @@ int run(const RunArguments& args) {
     // The VTK files of the design chosen, once the batch has succeeded.
     return status == 0 ? draw_design(*study, drawn, out, args.quiet) : status;
   }
-  return run_single(*study, out, vtk);
+  // A transient's verification rerun runs beside the run on a second core (-j 2 or more, or
+  // without -j where the machine has two).
+  const bool verify_beside =
+      args.threads > 0 ? args.threads >= 2 : std::thread::hardware_concurrency() >= 2;
+  return run_single(*study, out, vtk, verify_beside);
 }
 
 int dispatch(const std::vector<std::string>& args) {

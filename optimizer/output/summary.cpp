@@ -143,6 +143,7 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
             {"jacobian_evaluations", v->stats.jacobian_evaluations}};
         if (v->fixed_step > 0.0) j["verification"]["fixed_step"] = v->fixed_step;
         if (v->max_step > 0.0) j["verification"]["max_step"] = v->max_step;
+        j["verification"]["beside"] = v->beside;
       }
       if (const auto& r = a.refinement) {
         const Verification& f = r->first_run;

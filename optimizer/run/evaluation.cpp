@@ -1,13 +1,17 @@
 #include "optimizer/run/evaluation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <limits>
 #include <map>
 #include <memory>
+#include <thread>
 
+#include "core/analysis/dense_product.hpp"
 #include "core/analysis/sensitivity.hpp"
 #include "core/analysis/stop_request.hpp"
 #include "optimizer/run/expressions.hpp"
@@ -21,6 +25,66 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 AnalysisFault analysis_fault = nullptr;  // set_analysis_fault
+
+// The output rows of a transient, its first state included.
+long output_rows(const TransientOptions& options) {
+  return 1 + std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
+}
+
+// A verification rerun: its result and its bodies' samples at the outputs of the run it verifies.
+struct Rerun {
+  TransientResult result;
+  Trajectory samples;
+};
+
+// Runs `tight` (the tighter options of a run with `options`), keeping its samples.
+Rerun rerun(const Model& model, const TransientOptions& tight, const TransientOptions& options) {
+  Data data(model);
+  Trajectory samples = trajectory_of(model, output_rows(options));
+  TransientResult result =
+      run_transient(model, tight, data,
+                    [&samples](const TransientSample& s, const Data& d) { samples.record(s, d); });
+  return Rerun{std::move(result), std::move(samples)};
+}
+
+// A verification rerun run on its own thread beside the run it verifies
+// (EvaluationOptions::verify_beside): the two take the longer one's time rather than their sum.
+// The rerun shares only the model (immutable) and the structure cache (thread-safe); its products
+// run on its thread alone. Destroyed before take(), it cancels the rerun and waits for it.
+class RerunBeside {
+ public:
+  RerunBeside(const Model& model, TransientOptions tight, const TransientOptions& options)
+      : tight_(std::move(tight)) {
+    tight_.cancel = &cancel_;
+    thread_ = std::thread([this, &model, rows = options] {
+      try {
+        rerun_ = rerun(model, tight_, rows);
+      } catch (...) {
+        error_ = std::current_exception();
+      }
+    });
+  }
+  RerunBeside(const RerunBeside&) = delete;
+  RerunBeside& operator=(const RerunBeside&) = delete;
+  ~RerunBeside() {
+    cancel_.store(true, std::memory_order_relaxed);
+    if (thread_.joinable()) thread_.join();
+  }
+
+  // Waits for the rerun; rethrows what it threw.
+  Rerun take() {
+    thread_.join();
+    if (error_) std::rethrow_exception(error_);
+    return std::move(rerun_);
+  }
+
+ private:
+  std::atomic<bool> cancel_{false};
+  TransientOptions tight_;
+  Rerun rerun_;
+  std::exception_ptr error_;
+  std::thread thread_;  // last: started once the rest exists
+};
 
 class Runner {
  public:
@@ -309,9 +373,18 @@ class Runner {
       EnergyScales energy;
       std::string table_error;
       bool floored = false;
-      const std::optional<TransientResult> streamed =
-          stream_transient(spec, model, run_options, peaks, report, energy,
-                           verify ? &trajectory : nullptr, &floored, &table_error);
+      // A rerun known to be due runs beside the run where a core is spare; it is cancelled when
+      // the run fails (its destructor).
+      std::optional<RerunBeside> beside;
+      if (options_.verify_beside && !verification.empty())
+        beside.emplace(model, tighter(run_options, run_options.max_seconds), options);
+      std::optional<TransientResult> streamed;
+      {
+        std::optional<ProductThreads> one;  // the run's products on its own thread meanwhile
+        if (beside) one.emplace(1);
+        streamed = stream_transient(spec, model, run_options, peaks, report, energy,
+                                    verify ? &trajectory : nullptr, &floored, &table_error);
+      }
       if (!streamed) return;  // its outputs could not be begun (report.message says why)
       const TransientResult& result = *streamed;
       report.ok = result.ok;
@@ -353,7 +426,8 @@ class Runner {
         verification = verified_after_the_run(spec, model, run_options, result);
       report.verification.reset();
       if (!report.ok || verification.empty()) break;
-      report.verification = rerun_tighter(model, run_options, trajectory, result.stats);
+      report.verification = rerun_tighter(model, run_options, trajectory, result.stats,
+                                          beside ? beside->take() : std::optional<Rerun>());
       Verification& v = *report.verification;
       v.reason = verification;
       weigh_verification(options, &v);
@@ -467,12 +541,6 @@ class Runner {
     return true;
   }
 
-  // The output rows of a transient, its first state included.
-  static long output_rows(const TransientOptions& options) {
-    return 1 +
-           std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
-  }
-
   // The elastic modes of a modal result and the mode each frequency response read (chosen: per
   // response, an index into r.modes or -1).
   static void keep_modes(EvaluationStates::Analysis& state, const Model& model,
@@ -544,16 +612,32 @@ class Runner {
     return options;
   }
 
-  // Reruns the transient at rtol and atol divided by ten (a fixed step: at half the step, which
-  // sets its error, and the same tolerances, which set only the Newton iteration's and may be
-  // near the rounding floor already) and measures how far the run was from it. A rerun that
+  // The options of a verification rerun of a run with `options`: rtol and atol divided by ten (a
+  // fixed step: half the step, which sets its error, and the same tolerances, which set only the
+  // Newton iteration's and may be near the rounding floor already), within `seconds` of budget.
+  TransientOptions tighter(const TransientOptions& options, double seconds) {
+    TransientOptions tight = options;
+    tight.max_seconds = seconds;
+    tight = budgeted(tight);
+    if (tight.integrator.fixed_step > 0.0) {
+      tight.integrator.fixed_step /= 2.0;
+    } else {
+      tight.integrator.rtol /= 10.0;
+      tight.integrator.atol /= 10.0;
+    }
+    return tight;
+  }
+
+  // Reruns the transient with tighter(options) and measures how far the run was from it (`first`:
+  // that rerun, made beside the run). A rerun that
   // repeats the run state for state (its steps did not depend on the tolerances: a mechanism's
   // steps held by its stiff modes' bounds, the same at rtol 1e-6 and 1e-7 on a bob on a joint of
   // compliance 1e-9) measured nothing, and a distance of 0 would claim an exact run: its steps
   // then set its error, as a fixed step's do, and a second rerun with steps at most half the
   // run's mean step (t_end / its steps / 2) measures it.
   Verification rerun_tighter(const Model& model, const TransientOptions& options,
-                             const Trajectory& run, const SolverStats& run_stats) {
+                             const Trajectory& run, const SolverStats& run_stats,
+                             std::optional<Rerun> first) {
     Verification v;
     double seconds = 0.0;  // of the reruns so far
     // The analysis's max_seconds holds the run and its reruns together.
@@ -562,36 +646,26 @@ class Runner {
                  ? std::max(1e-3, options.max_seconds - run_stats.wall_seconds - seconds)
                  : 0.0;
     };
-    TransientOptions tight = options;
-    tight.max_seconds = left();
-    tight = budgeted(tight);
-    if (tight.integrator.fixed_step > 0.0) {
-      tight.integrator.fixed_step /= 2.0;
-    } else {
-      tight.integrator.rtol /= 10.0;
-      tight.integrator.atol /= 10.0;
-    }
+    TransientOptions tight = tighter(options, left());
     v.rtol = tight.integrator.rtol;
     v.atol = tight.integrator.atol;
     v.fixed_step = tight.integrator.fixed_step;
     bool repeated = false;
+    v.beside = first.has_value();
     const auto measure = [&] {
-      Data data(model);
-      Trajectory reference = trajectory_of(model, output_rows(options));
-      const TransientResult r = run_transient(
-          model, tight, data,
-          [&reference](const TransientSample& s, const Data& d) { reference.record(s, d); });
-      seconds += r.stats.wall_seconds;
-      v.ok = r.ok;
-      v.message = r.message;
-      v.stats = r.stats;
+      const Rerun r = first ? std::move(*first) : rerun(model, tight, options);
+      first.reset();
+      seconds += r.result.stats.wall_seconds;
+      v.ok = r.result.ok;
+      v.message = r.result.message;
+      v.stats = r.result.stats;
       v.stats.wall_seconds = seconds;  // of the reruns together
-      v.error = r.ok ? trajectory_error(run, reference) : kNaN;
-      v.rotation_error = r.ok ? trajectory_rotation_error(run, reference) : kNaN;
-      v.motion = largest_motion(reference);
-      v.turn = largest_turn(reference);
-      v.turned = largest_accumulated_turn(reference);
-      repeated = r.ok && same_samples(run, reference);
+      v.error = r.result.ok ? trajectory_error(run, r.samples) : kNaN;
+      v.rotation_error = r.result.ok ? trajectory_rotation_error(run, r.samples) : kNaN;
+      v.motion = largest_motion(r.samples);
+      v.turn = largest_turn(r.samples);
+      v.turned = largest_accumulated_turn(r.samples);
+      repeated = r.result.ok && same_samples(run, r.samples);
     };
     measure();
     if (repeated && !(tight.integrator.fixed_step > 0.0) && run_stats.steps > 0) {

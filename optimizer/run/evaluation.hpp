@@ -162,6 +162,11 @@ struct EvaluationOptions {
   // Where the analyses hand their drawings (optimizer/output/vtk_output.hpp files them as VTK);
   // nullptr: none.
   DrawingSink* vtk = nullptr;
+  // A transient's verification rerun known to be due before the run (verification_reason) runs
+  // beside it on a second thread, each with one thread for its products: a single run with a
+  // core to spare (beamrail run, -j 2 or more, or no -j on a machine of 2 cores or more). The
+  // results are the same to the bit either way; false: after it, as in a batch.
+  bool verify_beside = false;
 };
 
 // Runs every analysis of the study on `model` (the study's own or a design's), in the listed

@@ -34,8 +34,9 @@ struct Verification {
   // them (weigh_verification): NaN where not measured, and for a fixed step.
   double tolerances = std::numeric_limits<double>::quiet_NaN();
   double rotation_tolerances = std::numeric_limits<double>::quiet_NaN();
-  SolverStats stats;   // of the tighter run
-  std::string reason;  // why the run was verified: asked, or "verify": "auto"
+  SolverStats stats;    // of the tighter run
+  std::string reason;   // why the run was verified: asked, or "verify": "auto"
+  bool beside = false;  // the first rerun ran beside the run (EvaluationOptions::verify_beside)
 };
 
 // A transient run again at its verification's tighter tolerances, whose results replaced the

@@ -5,6 +5,7 @@
 // run as interrupted with the samples delivered so far.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <csignal>
 #include <functional>
@@ -162,6 +163,50 @@ TEST(TransientLimits, AStopRequestEndsTheRunAsInterrupted) {
     EXPECT_EQ(r.message, "interrupted");
     EXPECT_EQ(samples, 5);
     EXPECT_LT(r.t_reached, 0.05 + 1e-12);
+  }
+}
+
+// A run's own cancel flag (TransientOptions::cancel: a verification rerun beside a run that
+// failed) ends it as a stop request does, and no other run: a run beside it, without the flag,
+// goes on to t_end. Set from another thread while the run goes, and set before it starts.
+TEST(TransientLimits, ACancelFlagEndsThatRunAlone) {
+  const Model model = cantilever(R"([{"type": "force", "body": "tip", "value": [0, -1, 0]}])");
+  std::vector<std::string> methods = kMethods;
+  methods.push_back("auto");
+  for (const std::string& method : methods) {
+    SCOPED_TRACE(method);
+    std::atomic<bool> cancel{false};
+    TransientOptions cancelled = run_options(method, 1.0, 0.01);
+    cancelled.cancel = &cancel;
+    Data data(model), other_data(model);
+    int samples = 0;
+    const TransientResult r =
+        run_transient(model, cancelled, data, [&](const TransientSample&, const Data&) {
+          if (++samples == 5) {
+            // The other run, with no flag, while this one's flag is set.
+            cancel.store(true);
+            const TransientResult other =
+                run_transient(model, run_options(method, 0.05, 0.01), other_data, nullptr);
+            EXPECT_TRUE(other.ok) << other.message;
+            EXPECT_DOUBLE_EQ(other.t_reached, 0.05);
+          }
+        });
+    std::printf("%s: %s at t = %g after %d samples\n", method.c_str(), r.message.c_str(),
+                r.t_reached, samples);
+    EXPECT_FALSE(r.ok);
+    EXPECT_TRUE(r.interrupted);
+    EXPECT_EQ(r.message, "interrupted");
+    EXPECT_EQ(samples, 5);
+    EXPECT_LT(r.t_reached, 0.05 + 1e-12);
+    EXPECT_EQ(stop_requested(), 0);
+    // Set before the run: nothing past the initial state.
+    Data fresh(model);
+    int first = 0;
+    const TransientResult none = run_transient(
+        model, cancelled, fresh, [&first](const TransientSample&, const Data&) { ++first; });
+    EXPECT_TRUE(none.interrupted);
+    EXPECT_LE(none.t_reached, 0.0);
+    EXPECT_LE(first, 1);
   }
 }
 

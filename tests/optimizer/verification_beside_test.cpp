@@ -1,0 +1,104 @@
+// A transient's verification rerun known to be due before the run runs beside it on a second
+// thread in a single `beamrail run` (-j 2 or more, or no -j on a machine of two cores or more;
+// EvaluationOptions::verify_beside), so the two take the longer one's time rather than their sum.
+// The results must be those of the rerun after the run, to the bit, through a refinement too; a
+// run that fails must not wait for its rerun's end, nor keep its figures.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tests/support/study_runs.hpp"
+
+namespace beamrail {
+namespace {
+
+using Json = nlohmann::json;
+using testing::load_json;
+using testing::read_text;
+
+// A rotor spinning at 5 rad/s on a revolute joint, 2 s: a mechanism, so verified by default; at
+// bdf's rtol 1e-6 it is found 20 times off and refined (mechanism_verification_test.cpp), so both
+// the run and its refined run have a rerun beside them.
+Json rotor(const Json& integrator) {
+  Json s = Json::parse(R"({
+    "name": "rotor",
+    "scene": {
+      "gravity": [0, 0, 0],
+      "bodies": [{"name": "rotor", "mass": 2, "inertia": [0.01, 0.01, 0.02],
+                  "position": [0, 0, 0], "angular_velocity": [0, 0, 5]}],
+      "joints": [{"name": "axle", "type": "revolute", "body1": "ground", "body2": "rotor",
+                  "point": [0, 0, 0], "axis": [0, 0, 1]}]
+    },
+    "analyses": [{"type": "transient", "name": "spin", "t_end": 2.0, "output_step": 0.02}]
+  })");
+  s["analyses"][0]["integrator"] = integrator;
+  return s;
+}
+
+// The summary without its wall times (which differ between any two runs) and the flag compared.
+Json without_times(Json j) {
+  if (j.is_object()) {
+    Json out = Json::object();
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (it.key().find("seconds") == std::string::npos && it.key() != "beside")
+        out[it.key()] = without_times(it.value());
+    return out;
+  }
+  if (j.is_array())
+    for (Json& e : j) e = without_times(e);
+  return j;
+}
+
+class VerificationBeside : public testing::StudyRuns {};
+
+TEST_F(VerificationBeside, GivesTheSameResultsToTheBitThroughARefinement) {
+  const auto study =
+      write_study("rotor.json", rotor({{"method", "bdf"}, {"rtol", 1e-6}, {"atol", 1e-9}}));
+  run_ok(study, "beside", {"-j", "2"});
+  run_ok(study, "after", {"-j", "1"});
+  const Json beside = load_json(dir_ / "beside/summary.json");
+  const Json after = load_json(dir_ / "after/summary.json");
+  const Json& a = beside["analyses"][0];
+  std::printf("beside: run %.3f s, rerun %.3f s, whole %.3f s; after: %.3f s, %.3f s, %.3f s\n",
+              a["wall_seconds"].get<double>(), a["verification"]["wall_seconds"].get<double>(),
+              beside["wall_seconds"].get<double>(),
+              after["analyses"][0]["wall_seconds"].get<double>(),
+              after["analyses"][0]["verification"]["wall_seconds"].get<double>(),
+              after["wall_seconds"].get<double>());
+  ASSERT_TRUE(a.contains("refinement")) << beside.dump(2);
+  EXPECT_EQ(a["status"], "ok");
+  EXPECT_TRUE(a["verification"]["beside"].get<bool>());
+  EXPECT_FALSE(after["analyses"][0]["verification"]["beside"].get<bool>());
+  // The first run's verification (its rerun at 1e-7, beside) and the refined run's (at 1e-8).
+  EXPECT_GT(a["refinement"]["first_run"]["rotation_tolerances"].get<double>(), 10.0);
+  EXPECT_DOUBLE_EQ(a["verification"]["rtol"].get<double>(), 1e-8);
+  EXPECT_EQ(without_times(beside), without_times(after));
+  EXPECT_EQ(read_text(dir_ / "beside/spin.timeseries.csv"),
+            read_text(dir_ / "after/spin.timeseries.csv"));
+}
+
+// The run fails at max_steps after 2,000 steps, its rerun beside it still going (at rtol / 10,
+// cancelled then: TransientLimits.ACancelFlagEndsThatRunAlone tests the flag): the analysis
+// reports the run's failure and no verification, as after the run, where no rerun follows a
+// failed run, and the command exits 1.
+TEST_F(VerificationBeside, ARunThatFailsCancelsItsRerunAndReportsNone) {
+  const auto study = write_study(
+      "short.json",
+      rotor({{"method", "bdf"}, {"rtol", 1e-10}, {"atol", 1e-13}, {"max_steps", 2000}}));
+  for (const char* threads : {"2", "1"}) {
+    SCOPED_TRACE(threads);
+    const std::string out = std::string("j") + threads;
+    const testing::ProcessResult r =
+        run({"run", study.string(), "-o", out, "--quiet", "-j", threads});
+    EXPECT_TRUE(r.exited && r.status == 1) << r.how << "\n" << r.err;
+    const Json summary = load_json(dir_ / out / "summary.json");
+    const Json& a = summary["analyses"][0];
+    EXPECT_EQ(a["status"], "failed");
+    EXPECT_NE(a["message"].get<std::string>().find("max_steps"), std::string::npos) << a["message"];
+    EXPECT_FALSE(a.contains("verification")) << a.dump(2);
+  }
+}
+
+}  // namespace
+}  // namespace beamrail

@@ -694,7 +694,9 @@ class ModalExponential : public Integrator {
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
-        full_.compute(h, blocks_);
+        // The step's functions depend on h alone (the blocks are set at init): a step as long
+        // as the last (a mechanism's bound, max_step) reuses them.
+        if (h != full_.h) full_.compute(h, blocks_);
         if (reduced_) quasi_.restore();  // not a rejected trial's
         int sflag = kOk;
         const bool ok = step(full_, &sflag);

@@ -270,9 +270,9 @@ TEST(Integrators, ImplicitRungeKuttaFollowsRtolWhereAStiffModeRings) {
 // 1e-3 s (its fastest modes overdamped), 1 N step, 0.05 s, against a tight bdf run (which agrees
 // with Verner at rtol 1e-11 to 1.9e-11 of the motion). An evaluated stage derivative carries the
 // Newton iteration's error times the damped stiffness: at ARKODE's Newton coefficient 109 / 120
-// rtol off at rtol 1e-4 / 1e-6 (ESDIRK547 21 / 0.31), silent; at kDampedNewtonCoefficient 0.26 /
+// rtol off at rtol 1e-4 / 1e-6 (ESDIRK547 21 / 0.31), silent; at a coefficient of 1e-4 0.26 /
 // 0.33 (0.25 / 0.029), and 2.0e-5 / 8.9e-4 (1.2e-5 / 2.1e-4) since the steps end on the
-// outputs.
+// outputs; at kDampedNewtonCoefficient 1e-3 (2026-12-01) 4.9e-4 / 6.2e-4 (2.1e-4 / 1.7e-4).
 TEST(Integrators, ImplicitRungeKuttaFollowsRtolOnADampedBeam) {
   std::string scene = reference_cantilever(10);
   const size_t at = scene.find(R"("segments": 10)");
@@ -294,7 +294,8 @@ TEST(Integrators, ImplicitRungeKuttaFollowsRtolOnADampedBeam) {
 // 1e-4 / 1e-6 / 1e-8); with kDirkMaxErrorTestFailures (integrators.cpp) they run, against the
 // modal method at rtol 1e-10 (each mode's damping exact; bdf at rtol 1e-10 agrees to 3e-9 of the
 // motion) 0.014 / 0.16 / 0.45 of their tolerance (ESDIRK547 0.056 / 0.032 / 0.093); since the
-// steps end on the outputs, 8.5e-5 / 0.0030 / 0.036 (4.4e-5 / 8.7e-4 / 0.0033).
+// steps end on the outputs, 8.5e-5 / 0.0030 / 0.036 (4.4e-5 / 8.7e-4 / 0.0033); with the Newton
+// coefficient 1e-3 (2026-12-01) 1.3e-4 / 0.0034 / 0.033 (3.6e-5 / 5.4e-4 / 0.0023).
 TEST(Integrators, ImplicitRungeKuttaStepsThroughAnOverdampedMode) {
   const std::string scene = testing::point_mass_tip(0.04, 1000.0, 0.001);
   const Model model = scene_from_json(scene);

@@ -1,15 +1,12 @@
 #include "optimizer/run/evaluation.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <limits>
 #include <map>
 #include <memory>
-#include <thread>
 
 #include "core/analysis/dense_product.hpp"
 #include "core/analysis/sensitivity.hpp"
@@ -19,72 +16,13 @@
 #include "optimizer/run/responses.hpp"
 #include "optimizer/run/trajectory.hpp"
 #include "optimizer/run/transient_checks.hpp"
+#include "optimizer/run/verification_rerun.hpp"
 
 namespace beamrail {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 AnalysisFault analysis_fault = nullptr;  // set_analysis_fault
-
-// The output rows of a transient, its first state included.
-long output_rows(const TransientOptions& options) {
-  return 1 + std::max(1L, static_cast<long>(std::ceil(options.t_end / options.output_step - 1e-9)));
-}
-
-// A verification rerun: its result and its bodies' samples at the outputs of the run it verifies.
-struct Rerun {
-  TransientResult result;
-  Trajectory samples;
-};
-
-// Runs `tight` (the tighter options of a run with `options`), keeping its samples.
-Rerun rerun(const Model& model, const TransientOptions& tight, const TransientOptions& options) {
-  Data data(model);
-  Trajectory samples = trajectory_of(model, output_rows(options));
-  TransientResult result =
-      run_transient(model, tight, data,
-                    [&samples](const TransientSample& s, const Data& d) { samples.record(s, d); });
-  return Rerun{std::move(result), std::move(samples)};
-}
-
-// A verification rerun run on its own thread beside the run it verifies
-// (EvaluationOptions::verify_beside): the two take the longer one's time rather than their sum.
-// The rerun shares only the model (immutable) and the structure cache (thread-safe); its products
-// run on its thread alone. Destroyed before take(), it cancels the rerun and waits for it.
-class RerunBeside {
- public:
-  RerunBeside(const Model& model, TransientOptions tight, const TransientOptions& options)
-      : tight_(std::move(tight)) {
-    tight_.cancel = &cancel_;
-    thread_ = std::thread([this, &model, rows = options] {
-      try {
-        rerun_ = rerun(model, tight_, rows);
-      } catch (...) {
-        error_ = std::current_exception();
-      }
-    });
-  }
-  RerunBeside(const RerunBeside&) = delete;
-  RerunBeside& operator=(const RerunBeside&) = delete;
-  ~RerunBeside() {
-    cancel_.store(true, std::memory_order_relaxed);
-    if (thread_.joinable()) thread_.join();
-  }
-
-  // Waits for the rerun; rethrows what it threw.
-  Rerun take() {
-    thread_.join();
-    if (error_) std::rethrow_exception(error_);
-    return std::move(rerun_);
-  }
-
- private:
-  std::atomic<bool> cancel_{false};
-  TransientOptions tight_;
-  Rerun rerun_;
-  std::exception_ptr error_;
-  std::thread thread_;  // last: started once the rest exists
-};
 
 class Runner {
  public:

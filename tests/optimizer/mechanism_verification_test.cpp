@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "tests/support/spinning_rotor.hpp"
 #include "tests/support/stiff_joint_bob.hpp"
 #include "tests/support/study_runs.hpp"
 
@@ -217,21 +218,7 @@ TEST_F(MechanismVerification, ARerunThatFailsWarnsThatNothingWasMeasured) {
 // angle between two orientations (at most pi). bdf at rtol 1e-6 is far off against the
 // closed form (a turn of 5 t about z: 20 times) and warns; orientations past 3 rad were once not
 // checked.
-Json rotor(const Json& integrator) {
-  Json s = Json::parse(R"({
-    "name": "rotor",
-    "scene": {
-      "gravity": [0, 0, 0],
-      "bodies": [{"name": "rotor", "mass": 2, "inertia": [0.01, 0.01, 0.02],
-                  "position": [0, 0, 0], "angular_velocity": [0, 0, 5]}],
-      "joints": [{"name": "axle", "type": "revolute", "body1": "ground", "body2": "rotor",
-                  "point": [0, 0, 0], "axis": [0, 0, 1]}]
-    },
-    "analyses": [{"type": "transient", "name": "spin", "t_end": 2.0, "output_step": 0.02}]
-  })");
-  s["analyses"][0]["integrator"] = integrator;
-  return s;
-}
+Json rotor(const Json& integrator) { return testing::spinning_rotor(integrator); }
 
 // The largest angle of the rotor's orientations from the closed form's, a turn of 5 t about z
 // [rad].

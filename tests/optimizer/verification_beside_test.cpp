@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "tests/support/spinning_rotor.hpp"
 #include "tests/support/study_runs.hpp"
 
 namespace beamrail {
@@ -17,24 +18,10 @@ using Json = nlohmann::json;
 using testing::load_json;
 using testing::read_text;
 
-// A rotor spinning at 5 rad/s on a revolute joint, 2 s: a mechanism, so verified by default; at
-// bdf's rtol 1e-6 it is found 20 times off and refined (mechanism_verification_test.cpp), so both
-// the run and its refined run have a rerun beside them.
-Json rotor(const Json& integrator) {
-  Json s = Json::parse(R"({
-    "name": "rotor",
-    "scene": {
-      "gravity": [0, 0, 0],
-      "bodies": [{"name": "rotor", "mass": 2, "inertia": [0.01, 0.01, 0.02],
-                  "position": [0, 0, 0], "angular_velocity": [0, 0, 5]}],
-      "joints": [{"name": "axle", "type": "revolute", "body1": "ground", "body2": "rotor",
-                  "point": [0, 0, 0], "axis": [0, 0, 1]}]
-    },
-    "analyses": [{"type": "transient", "name": "spin", "t_end": 2.0, "output_step": 0.02}]
-  })");
-  s["analyses"][0]["integrator"] = integrator;
-  return s;
-}
+// The rotor of tests/support/spinning_rotor.hpp: at bdf's rtol 1e-6 it is found 20 times off and
+// refined (mechanism_verification_test.cpp), so both the run and its refined run have a rerun
+// beside them.
+Json rotor(const Json& integrator) { return testing::spinning_rotor(integrator); }
 
 // The summary without its wall times (which differ between any two runs) and the flag compared.
 Json without_times(Json j) {

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "tests/support/spinning_rotor.hpp"
 #include "tests/support/study_runs.hpp"
@@ -84,6 +85,24 @@ TEST_F(VerificationBeside, ARunThatFailsCancelsItsRerunAndReportsNone) {
     EXPECT_EQ(a["status"], "failed");
     EXPECT_NE(a["message"].get<std::string>().find("max_steps"), std::string::npos) << a["message"];
     EXPECT_FALSE(a.contains("verification")) << a.dump(2);
+  }
+}
+
+// Without -j the rerun goes beside the run only where the process may use two cores: under
+// taskset -c 0 it follows the run (it once shared the core with the run, whose budget then ran
+// out: an adversarial review), while -j 2 asks for it there all the same.
+TEST_F(VerificationBeside, OnOneCoreTheRerunFollowsTheRun) {
+  const auto study =
+      write_study("rotor.json", rotor({{"method", "bdf"}, {"rtol", 1e-6}, {"atol", 1e-9}}));
+  for (const bool asked : {false, true}) {
+    const std::string out = asked ? "asked" : "one";
+    std::vector<std::string> args{"-c", "0",      BEAMRAIL_EXECUTABLE, "run", study.string(), "-o",
+                                  out,  "--quiet"};
+    if (asked) args.insert(args.end(), {"-j", "2"});
+    const testing::ProcessResult r = testing::run_process("/usr/bin/taskset", args, dir_);
+    ASSERT_TRUE(r.exited && r.status == 0) << r.how << "\n" << r.err;
+    const Json a = load_json(dir_ / out / "summary.json")["analyses"][0];
+    EXPECT_EQ(a["verification"]["beside"].get<bool>(), asked) << out;
   }
 }
 

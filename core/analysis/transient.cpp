@@ -42,6 +42,15 @@ struct Stop {
   bool restart = true;
 };
 
+// A smooth ramp's stops: its ends and the times between that part it into this many, so that no
+// step is longer than this part of it. Its factor s - sin(2 pi s) / (2 pi) equals a linear ramp's
+// at s = 0, 1/2 and 1, the modal method's stage times over a step as long as the ramp: a load
+// ramped smoothly over 15 ms from the start of a run with outputs every 50 ms was integrated as a
+// linear ramp in one step, 1.47e-3 of the motion off at every rtol (1,470 rtol at 1e-6), ok and
+// silent, its verification rerun taking the same step (an adversarial review, 2026-12-01; tests/
+// core/analysis/transient_limits_test.cpp). With the stops the step control sees the curvature.
+constexpr int kSmoothRampStops = 8;
+
 // The stops of the time function f of a load or drive whose vector is not zero (a function
 // that scales nothing neither stops nor holds the steps).
 void append_stops(const TimeFunction& f, const Vec3& scaled, std::vector<Stop>& stops) {
@@ -50,7 +59,8 @@ void append_stops(const TimeFunction& f, const Vec3& scaled, std::vector<Stop>& 
   f.append_breakpoints(jumps);
   for (double t : jumps) stops.push_back({t, true});
   if (f.type == TimeFunction::Type::kSmoothRamp)
-    stops.insert(stops.end(), {{f.from, false}, {f.to, false}});
+    for (int k = 0; k <= kSmoothRampStops; ++k)
+      stops.push_back({f.from + (f.to - f.from) * k / kSmoothRampStops, false});
 }
 
 // The stops inside (0, t_end), in order, one per time (restarting if any there does).

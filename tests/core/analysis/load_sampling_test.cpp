@@ -80,8 +80,43 @@ TEST(LoadSampling, APulseBetweenTheOutputsMovesTheTipWhateverTheMethod) {
     std::printf("%s, rtol 1e-6: error %.3g = %.3g rtol, %ld steps\n", method_name(method), e,
                 e / rtol, r.result.stats.steps);
     // Measured: auto 1.4, bdf 0.37, dirk 2.3, erk 0.005 rtol (before: 1 of the motion, 1e6
-    // rtol; restarting at the ramps' ends instead of going on: bdf 3.8, dirk 9.0).
+    // rtol; restarting at the ramps' ends instead of going on: bdf 3.8, dirk 9.0); with stops
+    // inside the ramps (2026-12-01) 1.0, 0.29, 0.10, 0.004.
     EXPECT_LT(e, 10 * rtol) << method_name(method);
+  }
+}
+
+// A load ramped smoothly over its first 15 ms, outputs every 50 ms: the smooth ramp's factor
+// s - sin(2 pi s) / (2 pi) equals a linear ramp's at s = 0, 1/2 and 1, auto's stages over a step
+// as long as the ramp, and auto took one: the run was a linear ramp's to 1.3e-15 m, 1.47e-3 of
+// the motion off at every rtol (14.7 / 1,470 / 1.47e5 rtol at rtol 1e-4 / 1e-6 / 1e-8), ok and
+// silent (an adversarial review, 2026-12-01; on this rod 70 / 7,000 / 7e5 rtol in 7 steps). A
+// smooth ramp's eight parts are stops now (transient.cpp, kSmoothRampStops): 0.009 / 0.082 /
+// 0.17 rtol in 17 / 30 / 64 steps; bdf, dirk, erk at rtol 1e-6 0.70 / 1.6 / 0.001; every method
+// against Verner held below 1 ms.
+TEST(LoadSampling, ASmoothRampShorterThanAStepIsNotTakenForALinearOne) {
+  const Model model = scene_from_json(cantilever(R"([
+      {"type": "force", "body": "tip", "value": [0, 5, 2],
+       "time": {"type": "smooth_ramp", "from": 0.0, "to": 0.015}}])"));
+  const TransientRun reference =
+      run(model, IntegratorMethod::kErk, 0.3, 0.05, 1e-11, 1e-14, /*max_step=*/1e-3);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  std::printf("reference: the tip moves %.3g m\n", motion(model, reference));
+  for (double rtol : {1e-4, 1e-6, 1e-8}) {
+    const TransientRun r = run(model, IntegratorMethod::kAuto, 0.3, 0.05, rtol, 1e-2 * rtol);
+    ASSERT_TRUE(r.result.ok) << r.result.message;
+    const double e = run_error(model, r, reference);
+    std::printf("auto, rtol %.0e: error %.3g = %.3g rtol, %ld steps\n", rtol, e, e / rtol,
+                r.result.stats.steps);
+    EXPECT_LT(e, 10 * rtol) << "rtol " << rtol;
+  }
+  for (IntegratorMethod method :
+       {IntegratorMethod::kBdf, IntegratorMethod::kDirk, IntegratorMethod::kErk}) {
+    const TransientRun r = run(model, method, 0.3, 0.05, 1e-6, 1e-8);
+    ASSERT_TRUE(r.result.ok) << method_name(method) << ": " << r.result.message;
+    const double e = run_error(model, r, reference);
+    std::printf("%s, rtol 1e-6: error %.3g = %.3g rtol\n", method_name(method), e, e / 1e-6);
+    EXPECT_LT(e, 10 * 1e-6) << method_name(method);
   }
 }
 

@@ -550,9 +550,7 @@ class Runner {
 
   double budget_left(double own) const {
     if (options_.max_seconds <= 0.0) return own;
-    const double used =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const double left = std::max(1e-3, options_.max_seconds - used);
+    const double left = std::max(1e-3, options_.max_seconds - seconds_since(start_));
     return own > 0.0 ? std::min(own, left) : left;
   }
 

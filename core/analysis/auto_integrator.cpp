@@ -430,6 +430,7 @@ class AutoIntegrator : public Integrator {
   void record(double t, const std::string& method, const std::string& reason,
               bool relinearized = false) {
     MethodPhase p{t, method, reason, relinearized};
+    if (count_ > 0 && phase_started) phase_started(p);
     if (first_.size() + 1 < kMaxRecordedPhases)
       first_.push_back(std::move(p));
     else

@@ -3,6 +3,7 @@
 // sparse (KLU) linear algebra for the implicit ones.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +35,8 @@ class Integrator {
   // The highest frequency a band-limited modal method integrated [Hz], given or chosen (auto: the
   // highest of its modal phases); 0 when every mode was integrated or the method has no band.
   double band_hz = 0.0;
+  // Called as each phase after the first begins (TransientOptions::phase_started); empty: none.
+  std::function<void(const MethodPhase&)> phase_started;
   // The phases so far (auto switches methods and relinearizes; others have none) and their count.
   virtual std::vector<MethodPhase> phases(long* count) const {
     *count = 0;

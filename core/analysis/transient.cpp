@@ -268,6 +268,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return result;
     }
+    integrator->phase_started = options.phase_started;
     result.linear_solver = integrator->linear_solver;
     result.warnings = integrator->warnings;
     if (harmonic_step > 0.0 && io.fixed_step > harmonic_step) {

@@ -82,6 +82,15 @@ struct IntegratorOptions {
   bool IsValid(std::string* error) const;
 };
 
+// One phase of a run: from time t on, `method` ran, chosen for `reason` (auto; other methods have
+// one phase).
+struct MethodPhase {
+  double t = 0.0;
+  std::string method;  // "modal", "bdf", "dirk ESDIRK547L2SA2_7_4_5", ...
+  std::string reason;
+  bool relinearized = false;  // a modal phase linearized again as a body turned its limit
+};
+
 struct TransientOptions {
   double t_end = 1.0;         // [s]
   double output_step = 0.01;  // [s]
@@ -96,6 +105,10 @@ struct TransientOptions {
   // Set by another thread, it ends the run as interrupted at its next right-hand side (as a stop
   // request does, stop_request.hpp, for this run alone); nullptr: none.
   const std::atomic<bool>* cancel = nullptr;
+  // Called on the run's thread as each phase after the first begins (auto's relinearizations and
+  // hand-overs, as TransientResult::phases records them), before it integrates: what the run
+  // has become is known then rather than at its end. Empty: none.
+  std::function<void(const MethodPhase&)> phase_started;
 
   // Whether the options can run (t_end and output_step positive and finite, at most 1e8 output
   // steps, the integrator's options valid): true, or false with the first problem in *error.
@@ -117,15 +130,6 @@ struct SolverStats {
   long nonlinear_iterations = 0;
   long nonlinear_failures = 0;
   long error_test_failures = 0;
-};
-
-// One phase of a run: from time t on, `method` ran, chosen for `reason` (auto; other methods have
-// one phase).
-struct MethodPhase {
-  double t = 0.0;
-  std::string method;  // "modal", "bdf", "dirk ESDIRK547L2SA2_7_4_5", ...
-  std::string reason;
-  bool relinearized = false;  // a modal phase linearized again as a body turned its limit
 };
 
 struct TransientResult {

@@ -161,7 +161,8 @@ nlohmann::json evaluation_summary(const Study& study, const Model& model, const 
               {"rotation_tolerances", json_number(f.rotation_tolerances)},
               {"steps", r->first_stats.steps},
               {"wall_seconds", r->first_stats.wall_seconds},
-              {"verification_wall_seconds", f.stats.wall_seconds}}}};
+              {"verification_wall_seconds", f.stats.wall_seconds},
+              {"verification_beside", f.beside}}}};
       }
     }
     if (a.statics) {

@@ -317,15 +317,26 @@ class Runner {
       // A rerun known to be due runs beside the run where a core is spare; it is cancelled when
       // the run fails (its destructor).
       std::optional<RerunBeside> beside;
-      if (options_.verify_beside && !verification.empty())
-        beside.emplace(model, tighter(run_options, run_options.max_seconds), options);
-      std::optional<TransientResult> streamed;
-      {
-        std::optional<ProductThreads> one;  // the run's products on its own thread meanwhile
-        if (beside) one.emplace(1);
-        streamed = stream_transient(spec, model, run_options, peaks, report, energy,
-                                    verify ? &trajectory : nullptr, &floored, &table_error);
-      }
+      std::optional<ProductThreads> one;  // the run's products on its own thread meanwhile
+      const auto start_beside = [&] {  // its budget: what the run's leaves by the wall clock
+        const double left = run_options.max_seconds > 0.0
+                                ? std::max(1e-3, run_options.max_seconds - seconds_since(began))
+                                : 0.0;
+        beside.emplace(model, tighter(run_options, left), options);
+        one.emplace(1);
+      };
+      if (options_.verify_beside && !verification.empty()) start_beside();
+      // A rerun that auto's run makes due (verified_after_the_run) starts beside it at the
+      // phase that makes it so, not after the run.
+      TransientOptions streamed_options = run_options;
+      if (options_.verify_beside && verification.empty() && verify)
+        streamed_options.phase_started = [&](const MethodPhase& phase) {
+          if (!beside && phase_verifies(model, phase)) start_beside();
+        };
+      std::optional<TransientResult> streamed =
+          stream_transient(spec, model, streamed_options, peaks, report, energy,
+                           verify ? &trajectory : nullptr, &floored, &table_error);
+      one.reset();
       if (!streamed) return;  // its outputs could not be begun (report.message says why)
       const TransientResult& result = *streamed;
       report.ok = result.ok;

@@ -130,6 +130,10 @@ bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& 
 // Not where auto only handed over to dirk after a failed modal phase: a 100-segment cantilever
 // whose band failed at 3 us ran dirk, and its rerun at rtol 1e-7 was itself 21 times farther off
 // than the run (a false alarm).
+bool phase_verifies(const Model& model, const MethodPhase& phase) {
+  return (multistep(phase.method) && model.n_free() > 0) || phase.relinearized;
+}
+
 std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
                                    const TransientOptions& options, const TransientResult& result) {
   if (!may_verify_after_the_run(spec, options)) return "";
@@ -139,7 +143,7 @@ std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
     return by_default("auto handed the run to " + phase->method +
                       " at t = " + format_number(phase->t) + " s, " + kMultistepFindings);
   if (std::none_of(result.phases.begin(), result.phases.end(),
-                   [](const MethodPhase& p) { return p.relinearized; }))
+                   [&](const MethodPhase& p) { return phase_verifies(model, p); }))
     return "";
   return by_default("the run relinearized as bodies turned (" + std::to_string(result.phase_count) +
                     " phases): a large motion, where error control was found far off without a "

@@ -76,6 +76,10 @@ std::string verification_reason(const AnalysisSpec& spec, const Model& model,
 // Whether a transient that verification_reason does not verify may be verified after its run.
 bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& options);
 
+// Whether a phase of a run that may_verify_after_the_run makes verified_after_the_run verify it:
+// a hand-over to bdf or adams (of a scene with free bodies), or a relinearization.
+bool phase_verifies(const Model& model, const MethodPhase& phase);
+
 // Why a transient is verified after its run ("" when it is not): an auto run that handed a phase
 // to bdf, or that relinearized.
 std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,

@@ -29,7 +29,8 @@ Json without_times(Json j) {
   if (j.is_object()) {
     Json out = Json::object();
     for (auto it = j.begin(); it != j.end(); ++it)
-      if (it.key().find("seconds") == std::string::npos && it.key() != "beside")
+      if (it.key().find("seconds") == std::string::npos &&
+          it.key().find("beside") == std::string::npos)
         out[it.key()] = without_times(it.value());
     return out;
   }
@@ -86,6 +87,56 @@ TEST_F(VerificationBeside, ARunThatFailsCancelsItsRerunAndReportsNone) {
     EXPECT_NE(a["message"].get<std::string>().find("max_steps"), std::string::npos) << a["message"];
     EXPECT_FALSE(a.contains("verification")) << a.dump(2);
   }
+}
+
+// An auto run whose verification is decided by the run itself (it relinearized as bodies turned:
+// verified_after_the_run) starts its rerun beside it at the first such phase, not after the
+// run: the L-frame of large_motion_verification_test.cpp at rtol 1e-5 over 0.5 s relinearizes
+// from t = 0.014 s on (113 phases), is found off and refined. The results are those of the
+// rerun after the run, to the bit.
+TEST_F(VerificationBeside, AnAutoRunStartsItsRerunAtItsFirstRelinearization) {
+  const Json study_json = Json::parse(R"({
+    "name": "l_frame",
+    "scene": {
+      "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+      "sections": {"bar": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+      "bodies": [{"name": "tip", "mass": 1, "inertia": [1e-5, 1e-5, 1e-5], "position": [1, 0, 0],
+                  "velocity": [0, 2, 1]},
+                 {"name": "foot", "mass": 2, "inertia": [1e-4, 1e-4, 1e-4],
+                  "position": [1, -0.6, 0]}],
+      "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+                 "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "bar",
+                 "segments": 5},
+                {"name": "leg", "body1": "tip", "body2": "foot", "point1": [1, 0, 0],
+                 "point2": [1, -0.6, 0], "point3": [2, 0, 0], "material": "steel",
+                 "section": "bar", "segments": 3}],
+      "loads": [{"type": "force", "body": "tip", "value": [0, 0, -2]}]
+    },
+    "analyses": [{"type": "transient", "name": "swing", "t_end": 0.5, "output_step": 0.005,
+                  "integrator": {"rtol": 1e-5}}]
+  })");
+  const auto study = write_study("l_frame.json", study_json);
+  run_ok(study, "beside", {"-j", "2"});
+  run_ok(study, "after", {"-j", "1"});
+  const Json beside = load_json(dir_ / "beside/summary.json");
+  const Json after = load_json(dir_ / "after/summary.json");
+  const Json& a = beside["analyses"][0];
+  std::printf("beside: run %.3f s, reruns %.3f s, whole %.3f s; after: whole %.3f s\n",
+              a["wall_seconds"].get<double>(), a["verification"]["wall_seconds"].get<double>(),
+              beside["wall_seconds"].get<double>(), after["wall_seconds"].get<double>());
+  EXPECT_EQ(a["method"], "modal");
+  EXPECT_GT(a["phase_count"].get<long>(), 1);
+  EXPECT_GT(a["phases"][1]["t"].get<double>(), 0.0);
+  EXPECT_NE(a["verification"]["reason"].get<std::string>().find("relinearized"), std::string::npos)
+      << a["verification"]["reason"];
+  ASSERT_TRUE(a.contains("refinement")) << beside.dump(2);
+  EXPECT_TRUE(a["verification"]["beside"].get<bool>());
+  EXPECT_TRUE(a["refinement"]["first_run"]["verification_beside"].get<bool>());
+  EXPECT_FALSE(after["analyses"][0]["refinement"]["first_run"]["verification_beside"].get<bool>());
+  EXPECT_FALSE(after["analyses"][0]["verification"]["beside"].get<bool>());
+  EXPECT_EQ(without_times(beside), without_times(after));
+  EXPECT_EQ(read_text(dir_ / "beside/swing.timeseries.csv"),
+            read_text(dir_ / "after/swing.timeseries.csv"));
 }
 
 // Without -j the rerun goes beside the run only where the process may use two cores: under

@@ -7,6 +7,7 @@
 #include <exception>
 #include <numbers>
 
+#include "core/analysis/deformation_check.hpp"
 #include "core/analysis/dense_product.hpp"
 #include "core/analysis/explicit_stability.hpp"
 #include "core/analysis/exponential_step.hpp"
@@ -47,7 +48,8 @@ enum Flag {
   kStepTooSmall = kModalStepTooSmall,
   kNonFinite = kModalNonFinite,
   kTooFar = kModalTooFar,
-  kInertia = kModalInertia
+  kInertia = kModalInertia,
+  kOutOfRange = kModalOutOfRange
 };
 
 class ModalExponential : public Integrator {
@@ -131,6 +133,8 @@ class ModalExponential : public Integrator {
   int advance(double tout, double tstop, N_Vector y, double* t) override {
     const double target = std::min(tout, tstop);
     int flag = kOk;
+    context_->nonfinite_evaluations = 0;  // out-of-range trial states in this call
+    context_->out_of_range.clear();
     while (t_ < target && flag == kOk) {
       flag = step_towards(target);
       if (flag == kOk && inertia_limit_ > 0.0 && inertia_settled() &&
@@ -241,6 +245,8 @@ class ModalExponential : public Integrator {
         return detail_;
       case kInertia:
         return quasi_static_inertia_warning(quasi_static_inertia());
+      case kOutOfRange:
+        return context_->out_of_range + " (the modal integrator could not step past it)";
       default:
         return "modal integrator flag " + std::to_string(flag);
     }
@@ -504,6 +510,16 @@ class ModalExponential : public Integrator {
       *flag = kNonFinite;
       return false;
     }
+    // An element outside its law's range (checked at every evaluation, as the right-hand side
+    // of the other methods does, not only at the outputs: a carriage that left its rail's
+    // travel and came back between two outputs was once followed on, ok and silent).
+    if (context_->data.out_of_range) {
+      char when[48];
+      std::snprintf(when, sizeof when, "at t = %.9g s, ", t);
+      context_->out_of_range = when + element_out_of_range(context_->model, context_->data);
+      *flag = kOutOfRange;
+      return false;
+    }
     m0_v_.noalias() = m0_ * acceleration_;
     return true;
   }
@@ -693,7 +709,8 @@ class ModalExponential : public Integrator {
         h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate(ringing));
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
-        if (!(h > 1e-14 * std::max(1.0, std::abs(t_)))) return kStepTooSmall;
+        if (!(h > 1e-14 * std::max(1.0, std::abs(t_))))
+          return context_->out_of_range.empty() ? kStepTooSmall : kOutOfRange;
         // The step's functions depend on h alone (the blocks are set at init): a step as long
         // as the last (a mechanism's bound, max_step) reuses them.
         if (h != full_.h) full_.compute(h, blocks_);
@@ -712,6 +729,13 @@ class ModalExponential : public Integrator {
           // Perhaps a trial state too far out: retry smaller before giving up.
           if (attempt >= 10) return fail_flag(sflag);
           err = 1e10;
+        } else if (sflag == kOutOfRange) {
+          // A trial state outside an element's range: shorter, until the run stops where the
+          // element leaves it (a trial step too long may also overshoot and come back).
+          if (++context_->nonfinite_evaluations >= kNonFiniteLimit) return kOutOfRange;
+          ++stats_.error_test_failures;
+          h_ = 0.5 * h;
+          continue;
         } else if (sflag == kTooFar && attempt < 10 && largest_rotation() < 0.5 * max_rotation_) {
           // A trial step that overshoots the rotation limit from well inside it: shorter, so that
           // the run stops (or auto relinearizes) near the limit, not a long step before it.

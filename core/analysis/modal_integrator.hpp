@@ -91,6 +91,11 @@ inline constexpr int kModalNonFinite = -8;
 // The flag of a band-limited run stopped because the inertia its quasi-static modes leave out
 // passed the limit of set_modal_inertia_limit (y and t: the step's accepted state where it did).
 inline constexpr int kModalInertia = -21;
+// The flag of a run stopped because its trial states left the range of an element's law (a
+// carriage past its rail's travel, a beam bent past its angle limit) kNonFiniteLimit times within
+// one call, or because the step fell below the roundoff of the time while they did: the element
+// left its law where the run stopped (y and t: the last accepted state, inside the range).
+inline constexpr int kModalOutOfRange = -22;
 
 // The angular velocity of the fastest frame in which a modal integrator follows a floating part
 // of the scene that spins (core/analysis/modal_coordinates.hpp) [rad/s]; 0 in fixed axes or for

@@ -129,5 +129,51 @@ TEST(TransientRange, CarriageLeavingItsTravelEndsTheRun) {
   }
 }
 
+// A carriage (1 kg) on a rail from the origin along x with travel [0.1, 0.6] m, held at 0.3 m by
+// a soft axial beam (E S / l = 144 N/m, w = 12 rad/s) and sent towards the origin at 3 m/s: x =
+// 0.3 - 0.25 sin(w t) leaves the travel at t = asin(0.8) / w = 0.07727 s and would come back at
+// 0.1845 s, long before the first output (0.25 s, x = 0.265 m). Every method fails there: the
+// modal integrator and auto, which follow this linear motion in long steps, once checked the
+// travel at the outputs only and reported the run ok. With travel [0.04, 0.6] (x >= 0.05) every
+// method runs through.
+TEST(TransientRange, CarriageLeavingItsTravelBetweenOutputsEndsTheRun) {
+  const double w = 12.0, area = 3.14159265358979 * 0.01 * 0.01;
+  const double e_soft = 1.0 * w * w * 0.3 / area;
+  const double t_exit = std::asin(0.8) / w;
+  for (const double low : {0.1, 0.04}) {
+    for (const std::string method : {"auto", "modal", "bdf", "erk"}) {
+      for (const double rtol : {1e-4, 1e-8}) {
+        Scene s;
+        s.material("steel", kE, kG).material("soft", e_soft, e_soft / 2.6).circle("rod", 0.02);
+        s.body("carriage", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.3, 0, 0));
+        s.last_body()["velocity"] = testing::vec(-3.0, 0, 0);
+        s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0),
+               "steel", "rod");
+        s.last_rail()["travel"] = {low, 0.6};
+        s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "soft", "rod");
+        TransientOptions o = options(method, 0.5, 0.25);
+        o.integrator.rtol = rtol;
+        o.integrator.atol = 1e-3 * rtol;
+        const auto run = simulate(s.model(), o);
+        std::printf("travel [%.2f, 0.6], %s, rtol %.0e: %s at t = %.5f s (exit at %.5f s)%s%s\n",
+                    low, method.c_str(), rtol, run.result.ok ? "ok" : "failed",
+                    run.result.t_reached, t_exit, run.result.ok ? "" : ": ",
+                    run.result.message.c_str());
+        if (low < 0.05) {
+          EXPECT_TRUE(run.result.ok) << method << ": " << run.result.message;
+          // x(0.5) = 0.3 - 0.25 sin(6), to the tolerance.
+          EXPECT_NEAR(run.samples.back().c[1].x(), 0.3 - 0.25 * std::sin(6.0), 1e3 * rtol)
+              << method;
+        } else {
+          EXPECT_FALSE(run.result.ok) << method;
+          EXPECT_NE(run.result.message.find("left the rail"), std::string::npos)
+              << method << ": " << run.result.message;
+          EXPECT_NEAR(run.result.t_reached, t_exit, 2e-3) << method;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace beamrail

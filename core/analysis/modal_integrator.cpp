@@ -707,6 +707,12 @@ class ModalExponential : public Integrator {
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
         const bool mechanism_holds = mechanism_bound(ringing);
         h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate(ringing));
+        // The modes that carry the motion resolved (kResolvedPhase); a mechanism's steps
+        // resolve its ringing modes by their own bounds above.
+        if (!(bounds_.mechanism > 0.0))
+          if (const double w = modal_resolved_rate(blocks_.lambda, order_, z_, kResolvedShare);
+              w > 0.0)
+            h = std::min(h, kResolvedPhase / w);
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_))))

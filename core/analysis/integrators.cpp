@@ -86,8 +86,8 @@ std::string explain(int flag, const std::string& package, const std::string& nam
     return context.out_of_range.empty()
                ? "the step size fell to zero before the output time: the tolerances cannot be "
                  "met there, or the motion jumps; loosen rtol/atol or check the loads"
-               : context.out_of_range + " (the integrator could not step past it: its step fell "
-                                        "to zero)";
+               : context.out_of_range +
+                     " (the integrator could not step past it: its step fell to zero)";
   const size_t underscore = name.find('_');
   const std::string bare = underscore == std::string::npos ? name : name.substr(underscore + 1);
   // Repeated right-hand-side or Newton failures over states outside the element laws' range.
@@ -178,7 +178,8 @@ class SundialsIntegrator : public Integrator {
     // Reached by a step of zero length: a dirk run whose trial states left a rail's travel
     // shrank its step to 0 at the edge and then reported every output reached, the carriage
     // frozen there, ok (an adversarial review: 0.21 m off). The run ends where it stood.
-    if (const double now = current_time(); flag >= 0 && now < *t - 1e-12 * std::max(1.0, std::abs(*t))) {
+    if (const double now = current_time();
+        flag >= 0 && now < *t - 1e-12 * std::max(1.0, std::abs(*t))) {
       *t = now;
       return kStepVanished;
     }
@@ -194,10 +195,10 @@ class SundialsIntegrator : public Integrator {
     return s;
   }
   std::string failure(int flag) const final {
-    std::string why = explain(flag, package_, flag < 0 && flag != kNonFiniteState && flag != kStepVanished
-                                  ? name(flag)
-                                  : "",
-                              messages_.last, *context_, run_max_steps_);
+    std::string why =
+        explain(flag, package_,
+                flag < 0 && flag != kNonFiniteState && flag != kStepVanished ? name(flag) : "",
+                messages_.last, *context_, run_max_steps_);
     if (fixed_step_ && !context_->interrupted && !context_->timed_out)
       why += flag == -1  // *_TOO_MUCH_WORK
                  ? "; with fixed_step every step is taken: a longer fixed_step or a larger "

@@ -318,7 +318,7 @@ class Runner {
       // the run fails (its destructor).
       std::optional<RerunBeside> beside;
       std::optional<ProductThreads> one;  // the run's products on its own thread meanwhile
-      const auto start_beside = [&] {  // its budget: what the run's leaves by the wall clock
+      const auto start_beside = [&] {     // its budget: what the run's leaves by the wall clock
         const double left = run_options.max_seconds > 0.0
                                 ? std::max(1e-3, run_options.max_seconds - seconds_since(began))
                                 : 0.0;

@@ -156,19 +156,19 @@ TEST(TransientRange, CarriageLeavingItsTravelBetweenOutputsEndsTheRun) {
         s.material("steel", kE, kG).material("soft", e_soft, e_soft / 2.6).circle("rod", 0.02);
         s.body("carriage", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.3, 0, 0));
         s.last_body()["velocity"] = testing::vec(-0.25 * c.w, 0, 0);
-        s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0),
-               "steel", "rod");
+        s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "steel",
+               "rod");
         s.last_rail()["travel"] = {c.low, 0.6};
         s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "soft", "rod");
         TransientOptions o = options(method, 0.5, 0.25);
         o.integrator.rtol = rtol;
         o.integrator.atol = 1e-3 * rtol;
         const auto run = simulate(s.model(), o);
-        std::printf("w %.2f rad/s, travel [%.3f, 0.6], %s, rtol %.0e: %s at t = %.5f s (exit at "
-                    "%.5f s)%s%s\n",
-                    c.w, c.low, method.c_str(), rtol, run.result.ok ? "ok" : "failed",
-                    run.result.t_reached, t_exit, run.result.ok ? "" : ": ",
-                    run.result.message.c_str());
+        std::printf(
+            "w %.2f rad/s, travel [%.3f, 0.6], %s, rtol %.0e: %s at t = %.5f s (exit at "
+            "%.5f s)%s%s\n",
+            c.w, c.low, method.c_str(), rtol, run.result.ok ? "ok" : "failed", run.result.t_reached,
+            t_exit, run.result.ok ? "" : ": ", run.result.message.c_str());
         if (c.low < 0.05) {
           EXPECT_TRUE(run.result.ok) << method << ": " << run.result.message;
           // x(0.5) = 0.3 - 0.25 sin(0.5 w), to the tolerance.

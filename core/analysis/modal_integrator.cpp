@@ -702,17 +702,17 @@ class ModalExponential : public Integrator {
       // A mechanism's first step (from the run's start, a load's jump or auto's relinearization):
       // the modes as they will ring about the static state of the forces there.
       const ModeBlock& ringing = starting_ && bounds_.mechanism_wh > 0.0 ? start_ringing() : z_;
+      // The modes that carry the motion resolved (kResolvedPhase); a mechanism's steps resolve
+      // its ringing modes by their own bounds.
+      const double resolved_rate =
+          bounds_.mechanism > 0.0 ? 0.0
+                                  : modal_resolved_rate(blocks_.lambda, order_, z_, kResolvedShare);
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
         const bool mechanism_holds = mechanism_bound(ringing);
         h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate(ringing));
-        // The modes that carry the motion resolved (kResolvedPhase); a mechanism's steps
-        // resolve its ringing modes by their own bounds above.
-        if (!(bounds_.mechanism > 0.0))
-          if (const double w = modal_resolved_rate(blocks_.lambda, order_, z_, kResolvedShare);
-              w > 0.0)
-            h = std::min(h, kResolvedPhase / w);
+        if (resolved_rate > 0.0) h = std::min(h, kResolvedPhase / resolved_rate);
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_))))

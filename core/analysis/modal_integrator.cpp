@@ -119,6 +119,11 @@ class ModalExponential : public Integrator {
     std::sort(order_.begin(), order_.end(), [&](Eigen::Index a, Eigen::Index b) {
       return blocks_.lambda[a] > blocks_.lambda[b];
     });
+    // How far each mode moves a body per unit of its coordinate, in translation and rotation.
+    reach_ = Eigen::ArrayX2d::Zero(m_, 2);
+    for (Eigen::Index i = 0; i < m_; ++i)
+      for (Eigen::Index r = 0; r < n_; ++r)
+        reach_(i, (r % kD) / 3) = std::max(reach_(i, (r % kD) / 3), std::abs(phi_(r, i)));
     bounds_ = ModalStepBounds(
         o.rtol,
         blocks_.lambda.size() > 0 ? std::sqrt(std::max(blocks_.lambda.maxCoeff(), 0.0)) : 0.0,
@@ -705,8 +710,9 @@ class ModalExponential : public Integrator {
       // The modes that carry the motion resolved (kResolvedPhase); a mechanism's steps resolve
       // its ringing modes by their own bounds.
       const double resolved_rate =
-          bounds_.mechanism > 0.0 ? 0.0
-                                  : modal_resolved_rate(blocks_.lambda, order_, z_, kResolvedShare);
+          bounds_.mechanism > 0.0
+              ? 0.0
+              : modal_resolved_rate(blocks_.lambda, order_, z_, reach_, kResolvedShare);
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
@@ -843,6 +849,7 @@ class ModalExponential : public Integrator {
   InitialLinearization initial_;  // why the initial state was linearized about (modal_reference)
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
   Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
+  Eigen::ArrayX2d reach_;         // each mode's largest |Phi| over the translations, the rotations
   Eigen::VectorXd m0_v_;          // work space of project
   ModeBlocks blocks_;  // the modes' linear part: eigenvalues and damping (exponential_step.hpp)
   double damping_coupling_ = 0.0;  // modal_damping: the damping left in N, per mode velocity

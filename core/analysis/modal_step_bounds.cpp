@@ -62,19 +62,27 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 }
 
 double modal_resolved_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                           const ModeBlock& z, double share) {
-  const auto amplitude = [&](Eigen::Index i) {
-    return lambda[i] > 0.0 ? std::sqrt(z(i, 0) * z(i, 0) + z(i, 1) * z(i, 1) / lambda[i]) : 0.0;
-  };
-  double total = 0.0;
-  for (Eigen::Index i = 0; i < lambda.size(); ++i) total += amplitude(i);
-  if (!(total > 0.0)) return 0.0;
-  double above = 0.0;
-  for (Eigen::Index i : order) {
-    above += amplitude(i);
-    if (above > share * total) return std::sqrt(lambda[i]);
+                           const ModeBlock& z, const Eigen::ArrayX2d& reach, double share) {
+  double rate = 0.0;
+  for (int part = 0; part < 2; ++part) {  // the translations, the rotations
+    const auto amplitude = [&](Eigen::Index i) {
+      return lambda[i] > 0.0
+                 ? reach(i, part) * std::sqrt(z(i, 0) * z(i, 0) + z(i, 1) * z(i, 1) / lambda[i])
+                 : 0.0;
+    };
+    double total = 0.0;
+    for (Eigen::Index i = 0; i < lambda.size(); ++i) total += amplitude(i);
+    if (!(total > 0.0)) continue;
+    double above = 0.0;
+    for (Eigen::Index i : order) {
+      above += amplitude(i);
+      if (above > share * total) {
+        rate = std::max(rate, std::sqrt(lambda[i]));
+        break;
+      }
+    }
   }
-  return 0.0;
+  return rate;
 }
 
 ModeBlock ringing_about_static_state(const Eigen::ArrayXd& lambda, const ModeBlock& z,

@@ -129,7 +129,10 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // sampled at 0.25 s steps, dipped 30 mm out of its travel unseen (an adversarial review). So a
 // step resolves the modes that carry the motion: no longer than kResolvedPhase / w, w the
 // frequency of the slowest of the fastest oscillating modes that together hold more than
-// kResolvedShare of the sum of the modes' amplitudes (modal_resolved_rate). Its evaluations,
+// kResolvedShare of the sum of the modes' amplitudes in the bodies' motion (each mode's modal
+// amplitude times the largest translation, or rotation, it gives a body: a mass-normalized
+// amplitude alone undercounted a light carriage's fast swing against a heavy body's slow one
+// tenfold, and missed a 6 mm dip out of its travel; modal_resolved_rate). Its evaluations,
 // half a step apart, then lie at most pi / 16 apart in those modes' phase: an excursion they
 // miss is at most 1 - cos(pi / 32), 0.5 %, of its mode's amplitude (plus what the unresolved
 // modes carry, at most 2 kResolvedShare of the motion) - as error-controlled methods miss
@@ -141,10 +144,12 @@ inline constexpr double kResolvedPhase = 3.14159265358979323846 / 8.0;
 inline constexpr double kResolvedShare = 1e-2;
 
 // The frequency [rad/s] of the slowest of the fastest oscillating modes (lambda_i > 0) that
-// together hold more than `share` of the sum of their amplitudes sqrt(z_i^2 + zdot_i^2 /
-// lambda_i); `order` the modes from the fastest down; 0 when no such mode moves.
+// together hold more than `share` of the sum of their amplitudes reach_i sqrt(z_i^2 + zdot_i^2 /
+// lambda_i), the larger over the translations and the rotations: `reach` (modes x 2) each
+// mode's largest |Phi| over the bodies' translations (column 0) and rotations (column 1);
+// `order` the modes from the fastest down; 0 when no such mode moves.
 double modal_resolved_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                           const ModeBlock& z, double share);
+                           const ModeBlock& z, const Eigen::ArrayX2d& reach, double share);
 
 // z for the bounds of a step from a state where the forces may set modes ringing that do not
 // ring yet (a mechanism's first step, at the start or at a load's jump): each mode's

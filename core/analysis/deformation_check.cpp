@@ -1,7 +1,9 @@
 #include "core/analysis/deformation_check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "core/model/element_kinematics.hpp"
 
@@ -76,6 +78,18 @@ std::string element_out_of_range(const Model& model, const Data& data, double fr
                  f.xi(0), e.travel_min, e.travel_max);
   }
   return "";
+}
+
+double element_length_margin(const Model& model, const Data& data) {
+  double margin = std::numeric_limits<double>::infinity();
+  for (const Beam& e : model.beams)
+    margin = std::min(margin, frames(e.ends, data, rotation_measure(e)).xi(0));
+  for (const Rail& e : model.rails)
+    if (std::isfinite(e.travel_min) || std::isfinite(e.travel_max)) {
+      const double x = frames(e.ends, data, rotation_measure(e)).xi(0);
+      margin = std::min({margin, x - e.travel_min, e.travel_max - x});
+    }
+  return margin;
 }
 
 std::string element_turned_beyond(const Model& model, const Data& data, double limit) {

@@ -33,6 +33,11 @@ inline constexpr double kRailTravelWarning = 10.0;  // times the initial distanc
 // finds elements near the edge).
 std::string element_out_of_range(const Model& model, const Data& data, double fraction = 1.0);
 
+// How near the elements are to the edges of their laws' ranges in length, in the configuration
+// of data.pose: the smallest distance [m] of a beam's axial extent from zero and of a carriage
+// from its travel's ends; infinity where no element has such an edge.
+double element_length_margin(const Model& model, const Data& data);
+
 // The first element whose relative rotation (the angle of E1^T E2 in [0, pi]; for a cylindrical
 // rail, the angle between the rail's axis and the carriage's) exceeds `limit` [rad], described for
 // the user, or "". An element's angles phi pass pi, where its law repeats, only through such a

@@ -85,6 +85,18 @@ double modal_resolved_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen
   return rate;
 }
 
+double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
+                       const ModeBlock& z, const Eigen::ArrayX2d& reach, double length,
+                       double share) {
+  double above = 0.0;
+  for (Eigen::Index i : order) {
+    if (!(lambda[i] > 0.0)) continue;
+    above += reach(i, 0) * std::sqrt(z(i, 0) * z(i, 0) + z(i, 1) * z(i, 1) / lambda[i]);
+    if (above > share * length) return std::sqrt(lambda[i]);
+  }
+  return 0.0;
+}
+
 ModeBlock ringing_about_static_state(const Eigen::ArrayXd& lambda, const ModeBlock& z,
                                      const Eigen::VectorXd& psi_a) {
   ModeBlock out = z;

@@ -151,6 +151,28 @@ inline constexpr double kResolvedShare = 1e-2;
 double modal_resolved_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
                            const ModeBlock& z, const Eigen::ArrayX2d& reach, double share);
 
+// A share of the motion is no bound where an element is near the edge of its range: a carriage
+// swinging 5 mm at 200 rad/s, its travel's end just inside its lowest point, beside a 10 kg body
+// swinging 1 m at 3 rad/s elsewhere in the scene, was under kResolvedShare of the motion and
+// stepped over (an adversarial review). So also no longer than kResolvedPhase / w, w the
+// frequency of the slowest of the fastest oscillating modes whose translation amplitudes
+// together reach kEdgeShare of the smallest length margin of an element to its range
+// (element_length_margin in core/analysis/deformation_check.hpp: a beam's axial extent, a
+// carriage's distance to its travel's ends): the modes left unresolved cannot carry an element
+// across its margin (a swing of amplitude A moves 2 A at most). The amplitudes are taken about
+// the linearization, so a static deflection counts too (conservative). Not the angles' margins:
+// counted so (amplitudes about the linearization against 1.5 rad), a cantilever twisted by a
+// step torque had every step held (1,672 steps at any rtol, its error 1e-5 of rtol), and an
+// element nearing its angle limit turns far from the linearization, where auto relinearizes.
+inline constexpr double kEdgeShare = 0.5;
+
+// The frequency [rad/s] of the slowest of the fastest oscillating modes whose translation
+// amplitudes reach_i sqrt(z_i^2 + zdot_i^2 / lambda_i) (reach column 0) together pass `share`
+// times `length`; 0 when none do.
+double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
+                       const ModeBlock& z, const Eigen::ArrayX2d& reach, double length,
+                       double share);
+
 // z for the bounds of a step from a state where the forces may set modes ringing that do not
 // ring yet (a mechanism's first step, at the start or at a load's jump): each mode's
 // displacement from the static state of the forces at the step's start, |psi_a_i| / lambda_i

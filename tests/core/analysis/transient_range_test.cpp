@@ -233,5 +233,82 @@ TEST(TransientRange, TwoModesLeavingTheTravelTogetherBetweenOutputsEndTheRun) {
   }
 }
 
+// A carriage (0.1 kg) on a spring (4,000 N/m) swinging x = 0.3 - 0.005 sin(200 t), beside a
+// 10 kg body on a 10 m soft beam swinging 1 m at 3 rad/s elsewhere in the scene: with travel
+// [0.2955, 5] m the carriage leaves it at asin(0.9) / 200 = 0.0055988 s. Its swing is under 1 %
+// of the scene's motion, and the modal method, whose steps resolved only the modes carrying
+// that share, stepped over it (4 steps in 0.5 s, ok; an adversarial review). The steps now also
+// resolve the modes that could carry an element across half its margin (kEdgeShare). With
+// travel [0.2945, 5] (0.5 mm below the carriage's lowest point) the run goes through.
+TEST(TransientRange, ASmallSwingNearItsEdgeBesideALargeMotionElsewhereEndsTheRun) {
+  const double area = 3.14159265358979 * 0.01 * 0.01;
+  const double e_carriage = 4000.0 * 0.3 / area, e_heavy = 90.0 * 10.0 / area;
+  for (const double low : {0.2955, 0.2945}) {
+    for (const std::string method : {"auto", "modal"}) {
+      for (const double rtol : {1e-4, 1e-8}) {
+        Scene s;
+        s.material("steel", kE, kG)
+            .material("sc", e_carriage, e_carriage / 2.6)
+            .material("sh", e_heavy, e_heavy / 2.6)
+            .circle("rod", 0.02);
+        s.body("carriage", 0.1, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.3, 0, 0));
+        s.last_body()["velocity"] = testing::vec(-1.0, 0, 0);
+        s.body("heavy", 10.0, Vec3(0.1, 0.1, 0.1), Vec3(10, 2, 0));
+        s.last_body()["velocity"] = testing::vec(3.0, 0, 0);
+        s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "steel",
+               "rod");
+        s.last_rail()["travel"] = {low, 5.0};
+        s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "sc", "rod");
+        s.beam("hold", "ground", "heavy", Vec3(0, 2, 0), Vec3(10, 2, 0), "sh", "rod");
+        TransientOptions o = options(method, 0.5, 0.25);
+        o.integrator.rtol = rtol;
+        o.integrator.atol = 1e-3 * rtol;
+        const auto run = simulate(s.model(), o);
+        std::printf("travel [%.4f, 5], %s, rtol %.0e: %s at t = %.6f s, %ld steps%s%s\n", low,
+                    method.c_str(), rtol, run.result.ok ? "ok" : "failed", run.result.t_reached,
+                    run.result.stats.steps, run.result.ok ? "" : ": ", run.result.message.c_str());
+        if (low < 0.295) {
+          EXPECT_TRUE(run.result.ok) << method << ": " << run.result.message;
+          // The heavy body at 0.5 s: 10 + sin(1.5) m, to the tolerance.
+          EXPECT_NEAR(run.samples.back().c[2].x(), 10.0 + std::sin(1.5), 1e3 * rtol) << method;
+        } else {
+          EXPECT_FALSE(run.result.ok) << method;
+          EXPECT_NE(run.result.message.find("left the rail"), std::string::npos) << method;
+          EXPECT_NEAR(run.result.t_reached, std::asin(0.9) / 200.0, 1e-4) << method;
+        }
+      }
+    }
+  }
+}
+
+// A carriage (1 kg) at rest on a spring of 144 N/m (w = 12 rad/s), pushed from t = 0 by 18 N
+// towards the origin: x = 0.3 - 0.125 (1 - cos(w t)) swings down to 0.05 m at 0.262 s and is
+// back at 0.295 m at the output of 0.5 s. With travel [0.1, 0.6] it leaves at acos(-0.6) / w =
+// 0.18452 s. At rest the modes hold no amplitude about the linearization; the first steps are
+// short all the same, and from them on the swing is resolved.
+TEST(TransientRange, ACarriagePushedFromRestLeavesItsTravelBetweenOutputs) {
+  const double area = 3.14159265358979 * 0.01 * 0.01, e_soft = 144.0 * 0.3 / area;
+  for (const std::string method : {"auto", "modal", "bdf"}) {
+    Scene s;
+    s.material("steel", kE, kG).material("soft", e_soft, e_soft / 2.6).circle("rod", 0.02);
+    s.body("carriage", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.3, 0, 0));
+    s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "steel",
+           "rod");
+    s.last_rail()["travel"] = {0.1, 0.6};
+    s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "soft", "rod");
+    s.force("carriage", Vec3(-18.0, 0, 0));
+    TransientOptions o = options(method, 1.0, 0.5);
+    o.integrator.rtol = 1e-6;
+    o.integrator.atol = 1e-9;
+    const auto run = simulate(s.model(), o);
+    std::printf("%s: %s at t = %.5f s, %ld steps%s%s\n", method.c_str(),
+                run.result.ok ? "ok" : "failed", run.result.t_reached, run.result.stats.steps,
+                run.result.ok ? "" : ": ", run.result.message.c_str());
+    EXPECT_FALSE(run.result.ok) << method;
+    EXPECT_NE(run.result.message.find("left the rail"), std::string::npos) << method;
+    EXPECT_NEAR(run.result.t_reached, std::acos(-0.6) / 12.0, 1e-3) << method;
+  }
+}
+
 }  // namespace
 }  // namespace beamrail

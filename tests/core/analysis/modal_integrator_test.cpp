@@ -340,7 +340,8 @@ TEST(ModalIntegrator, ObservedOrderOfConvergence) {
     if (previous > 0.0) {
       const double order = std::log2(previous / e);
       lowest_order = std::min(lowest_order, order);
-      std::printf("h %.3e: error %.3e, observed order %.2f, %ld steps\n", h, e, order, run.result.stats.steps);
+      std::printf("h %.3e: error %.3e, observed order %.2f, %ld steps\n", h, e, order,
+                  run.result.stats.steps);
     } else {
       std::printf("h %.3e: error %.3e, %ld steps\n", h, e, run.result.stats.steps);
     }

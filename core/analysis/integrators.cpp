@@ -299,7 +299,9 @@ class Cvode : public SundialsIntegrator {
     mem_ = CVodeCreate(o.method == IntegratorMethod::kAdams ? CV_ADAMS : CV_BDF, ctx);
     if (!mem_) return fail(error, "could not create CVODE");
     CVodeSetErrHandlerFn(mem_, &SundialsMessages::handler, &messages_);
-    if (CVodeInit(mem_, ode_rhs, 0.0, y0) < 0 || CVodeSStolerances(mem_, o.rtol, o.atol) < 0 ||
+    rtol_ = o.rtol;
+    atol_ = o.atol;
+    if (CVodeInit(mem_, ode_rhs, 0.0, y0) < 0 || CVodeWFtolerances(mem_, ode_error_weights) < 0 ||
         CVodeSetUserData(mem_, &c) < 0)
       return fail(error, "CVODE set-up failed: " + messages_.last);
     if (!algebra_.make(o, c, ctx, y0, error)) return false;
@@ -322,7 +324,26 @@ class Cvode : public SundialsIntegrator {
   ~Cvode() override { CVodeFree(&mem_); }
 
  private:
+  // CVODE's own weights for scalar tolerances (1 / (rtol |y_i| + atol), the same arithmetic), and
+  // the state they are asked for shown to step_taken: CVODE asks at the start of each step for
+  // the state its last step accepted (and at a start for the initial state), so every accepted
+  // state is seen, with no change to the steps (in one-step mode a step ending on both the output
+  // and the stop time would plan its successor differently).
+  int weights(N_Vector y, N_Vector w) {
+    const double* a = N_VGetArrayPointer(y);
+    double* out = N_VGetArrayPointer(w);
+    const long n = N_VGetLength(y);
+    for (long i = 0; i < n; ++i) {
+      const double scale = rtol_ * std::abs(a[i]) + atol_;
+      if (scale <= 0.0) return -1;
+      out[i] = 1.0 / scale;
+    }
+    if (context_->step_taken) context_->step_taken(current_time(), a);
+    return 0;
+  }
   int evolve(double tout, double tstop, N_Vector y, double* t, long max_steps) override {
+    // The context may serve another CVODE integrator of the same run (auto's phases).
+    context_->error_weights = [this](N_Vector y, N_Vector w) { return weights(y, w); };
     CVodeSetMaxNumSteps(mem_, max_steps);
     // A multistep method's step ends on the output only where the next step would be longer than
     // the spacing: each cut step perturbs its history. Ending every step on the outputs took bdf
@@ -339,6 +360,7 @@ class Cvode : public SundialsIntegrator {
     return CVode(mem_, tout, y, t, CV_NORMAL);
   }
   void reinit(double t, N_Vector y) override { CVodeReInit(mem_, t, y); }
+  double rtol_ = 0.0, atol_ = 0.0;
   double current_time() const override {
     double now = 0.0;
     CVodeGetCurrentTime(mem_, &now);

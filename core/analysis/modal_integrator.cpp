@@ -76,6 +76,7 @@ class ModalExponential : public Integrator {
                              " here) unless band-limited (max_frequency_hz): use bdf or dirk "
                              "with the sparse solver");
     y13_.resize(model.n_states);
+    watched_.resize(model.n_states);
     acceleration_.resize(n_);
     ydot13_.resize(model.n_states);
     const double* y = N_VGetArrayPointer(y0);
@@ -775,6 +776,10 @@ class ModalExponential : public Integrator {
           have_n0_ = false;
           starting_ = false;
           ++stats_.steps;
+          if (context_->step_taken) {  // every step that uses it writes its own states again
+            coordinates_.states(t_, x_, watched_.data());
+            context_->step_taken(t_, watched_.data());
+          }
           const double grow = err > 0.0 ? 0.9 * std::pow(err, -kExponent) : 4.0;
           if (h >= 0.999 * h_ || grow < 1.0) h_ = h * std::clamp(grow, 0.2, attempt ? 1.0 : 4.0);
           return kOk;
@@ -876,6 +881,7 @@ class ModalExponential : public Integrator {
   StepFunctions full_;
   Block stage_n_[StepFunctions::kStages];
   std::vector<double> y13_, ydot13_;
+  std::vector<double> watched_;  // an accepted step's states, for OdeContext::step_taken
   SolverStats stats_;
   int far_body_ = -1;
   std::string detail_;

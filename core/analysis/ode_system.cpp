@@ -132,10 +132,15 @@ int ode_project(double, N_Vector ycur, N_Vector corr, double, N_Vector err, void
   return 0;
 }
 
-int ode_normalize(double, N_Vector y, void* user_data) {
+int ode_normalize(double t, N_Vector y, void* user_data) {
   auto* c = static_cast<OdeContext*>(user_data);
   normalize_quaternions(c->model, N_VGetArrayPointer(y));
+  if (c->step_taken) c->step_taken(t, N_VGetArrayPointer(y));
   return 0;
+}
+
+int ode_error_weights(N_Vector y, N_Vector weights, void* user_data) {
+  return static_cast<OdeContext*>(user_data)->error_weights(y, weights);
 }
 
 }  // namespace beamrail

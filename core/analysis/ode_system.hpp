@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -59,6 +60,16 @@ struct OdeContext {
   // from its first stage on. Before this, auto ended 2.6 rtol off and a fixed-step DIRK 1.1e-3
   // (the step's first stage had the load off).
   double stretch_start = -std::numeric_limits<double>::infinity();
+  // Called with each state an integrator accepts (its time and the model's states), between the
+  // steps: the analysis watches the element laws' range there (DeformationCheck), not only at the
+  // output rows, which a swing can pass between. Empty: nothing is called. Every method calls it:
+  // ARKODE's after each step (ode_normalize), CVODE's where it asks for the error weights of the
+  // state it accepted (ode_error_weights), the modal method as it accepts a step.
+  std::function<void(double t, const double* y)> step_taken;
+  // CVODE's error weights 1 / (rtol |y_i| + atol), computed by its integrator (CVodeWFtolerances):
+  // CVODE asks for them once per accepted step, with that step's state. Returns 0, or -1 where a
+  // weight would be infinite.
+  std::function<int(N_Vector y, N_Vector weights)> error_weights;
 
   // The time the forces are evaluated at for the integrator's time t.
   double force_time(double t) const {
@@ -83,7 +94,9 @@ int ode_sparse_jacobian(double t, N_Vector y, N_Vector fy, SUNMatrix jac, void* 
                         N_Vector, N_Vector);
 // CVODE projection onto |q| = 1 (corrections and error estimate).
 int ode_project(double t, N_Vector ycur, N_Vector corr, double eps, N_Vector err, void* user_data);
-// After each step of ARKODE methods, which have no projection: q <- q / |q|.
+// After each step of ARKODE methods, which have no projection: q <- q / |q|; then step_taken.
 int ode_normalize(double t, N_Vector y, void* user_data);
+// CVODE's error weights (OdeContext::error_weights).
+int ode_error_weights(N_Vector y, N_Vector weights, void* user_data);
 
 }  // namespace beamrail

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -175,9 +176,15 @@ TEST(Extremes, DeformationBeyondTheSmallAngleRangeIsAWarning) {
                 peak);
     EXPECT_GT(beyond, 10);
     EXPECT_EQ(count_containing(run.result.warnings, arm), 1);
-    char angle[32];
-    std::snprintf(angle, sizeof angle, "|phi| reached %.3g rad", peak);
-    EXPECT_EQ(count_containing(run.result.warnings, angle), 1) << angle;
+    // The warning's peak is that of the accepted steps, which include the rows: at least the
+    // rows' peak, at most the overshoot of a step load on a linear oscillator, twice the static
+    // 0.4 rad (printed to three digits).
+    double reported = 0.0;
+    for (const std::string& w : run.result.warnings)
+      if (const size_t at = w.find("|phi| reached "); at != std::string::npos)
+        reported = std::atof(w.c_str() + at + 14);
+    EXPECT_GE(reported, peak - 5e-4);
+    EXPECT_LE(reported, 0.8005);
   }
   {
     // A carriage turning freely on a cylindrical rail (3 rad in 1.5 s) does not deform it.

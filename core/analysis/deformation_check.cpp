@@ -84,11 +84,28 @@ double element_length_margin(const Model& model, const Data& data) {
   double margin = std::numeric_limits<double>::infinity();
   for (const Beam& e : model.beams)
     margin = std::min(margin, frames(e.ends, data, rotation_measure(e)).xi(0));
-  for (const Rail& e : model.rails)
-    if (std::isfinite(e.travel_min) || std::isfinite(e.travel_max)) {
-      const double x = frames(e.ends, data, rotation_measure(e)).xi(0);
+  for (const Rail& e : model.rails) {
+    const double x = frames(e.ends, data, rotation_measure(e)).xi(0);
+    if (std::isfinite(e.travel_min) || std::isfinite(e.travel_max))
       margin = std::min({margin, x - e.travel_min, e.travel_max - x});
-    }
+    else if (const double m = kRailTravelWarning * e.ends.length - std::abs(x); m > 0.0)
+      margin = std::min(margin, m);
+    else
+      margin = std::min(margin, kWarnedMargin * std::abs(x));
+  }
+  return margin;
+}
+
+double element_angle_margin(const Model& model, const Data& data) {
+  double margin = std::numeric_limits<double>::infinity();
+  const auto add = [&margin](const ElementEnds& ends, const Data& d, RotationMeasure measure) {
+    const double angle = element_angle(frames(ends, d, measure), measure);
+    margin = std::min(margin, angle < kSmallAngleLimit
+                                  ? kSmallAngleLimit - angle
+                                  : std::min(angle_limit(measure) - angle, kWarnedMargin * angle));
+  };
+  for (const Beam& e : model.beams) add(e.ends, data, rotation_measure(e));
+  for (const Rail& e : model.rails) add(e.ends, data, rotation_measure(e));
   return margin;
 }
 

@@ -26,6 +26,11 @@ namespace beamrail {
 
 inline constexpr double kSmallAngleLimit = 0.5;     // [rad]
 inline constexpr double kRailTravelWarning = 10.0;  // times the initial distance
+// Past a warning's edge, the part of an element's angle (distance) that element_angle_margin
+// (element_length_margin) gives as its margin: the modal method's steps resolve the swings of
+// that size, so that the peak the warning reports is the motion's, not a step's
+// (core/analysis/modal_step_bounds.hpp).
+inline constexpr double kWarnedMargin = 0.1;
 
 // The first element outside the range of its law in the configuration of data.pose, described
 // for the user ("beam \"arm\" turned 3.02 rad ..."), or "" when every element is inside.
@@ -34,9 +39,17 @@ inline constexpr double kRailTravelWarning = 10.0;  // times the initial distanc
 std::string element_out_of_range(const Model& model, const Data& data, double fraction = 1.0);
 
 // How near the elements are to the edges of their laws' ranges in length, in the configuration
-// of data.pose: the smallest distance [m] of a beam's axial extent from zero and of a carriage
-// from its travel's ends; infinity where no element has such an edge.
+// of data.pose: the smallest distance [m] of a beam's axial extent from zero, of a carriage from
+// its travel's ends and, on a rail without a travel, of a carriage inside kRailTravelWarning
+// times its initial distance from that distance (beyond it, kWarnedMargin of its distance);
+// infinity where no element has such an edge.
 double element_length_margin(const Model& model, const Data& data);
+
+// How near the elements are to the edges of their angles, in the configuration of data.pose: the
+// smallest distance [rad] of an element's angle (element_angle) from the next edge above it:
+// kSmallAngleLimit while it is below it, else the limit of its measure (angle_limit), and then
+// at most kWarnedMargin of the angle; infinity without elements.
+double element_angle_margin(const Model& model, const Data& data);
 
 // The first element whose relative rotation (the angle of E1^T E2 in [0, pi]; for a cylindrical
 // rail, the angle between the rail's axis and the carriage's) exceeds `limit` [rad], described for

@@ -230,6 +230,44 @@ class ModalExponential : public Integrator {
     return start_ringing_;
   }
 
+  // The frequency [rad/s] of the modes a step from the accepted state must resolve so that no
+  // element crosses an edge of its range or of its warnings unseen (modal_edge_rate); 0: none.
+  // Either N at that state is in n0_, or (every mode integrated) M0 a is in m0_v_ and a in
+  // acceleration_: there the modal accelerations cost a pass over Phi, taken only when a bound on
+  // the swings (|psi_a_i| <= |a|_M0, the modes mass-normalized) does not already rule the edges
+  // out (the braced tower: never).
+  double edge_rate() {
+    const Model& model = context_->model;
+    const double length = element_length_margin(model, context_->data);
+    const double angle = element_angle_margin(model, context_->data);
+    const Eigen::ArrayXd& lambda = blocks_.lambda;
+    const auto damping = [this](Eigen::Index i) {
+      return blocks_.damped() ? blocks_.damping[i] * z_(i, 1) : 0.0;
+    };
+    edge_psi_a_.resize(m_);
+    if (have_n0_) {
+      for (Eigen::Index i = 0; i < m_; ++i)
+        edge_psi_a_[i] = n0_(i, 1) - lambda[i] * z_(i, 0) - damping(i);
+    } else {
+      const double a_norm = std::sqrt(std::max(acceleration_.dot(m0_v_), 0.0));
+      double translation = 0.0, rotation = 0.0;
+      for (Eigen::Index i = 0; i < m_; ++i) {
+        if (!(lambda[i] > 0.0)) continue;
+        const double swing =
+            (a_norm + std::abs(damping(i))) / lambda[i] + std::abs(z_(i, 1)) / std::sqrt(lambda[i]);
+        translation += reach_(i, 0) * swing;
+        rotation += reach_(i, 1) * swing;
+      }
+      if (!(translation > kEdgeShare * length) && !(2.0 * rotation > kEdgeShare * angle))
+        return 0.0;
+      multiply_transposed(phi_, m0_v_.data(), edge_psi_a_.data());
+    }
+    const Eigen::ArrayXd swing =
+        modal_swing(lambda, blocks_.damped() ? blocks_.damping : Eigen::ArrayXd(), z_, edge_psi_a_);
+    return std::max(modal_edge_rate(lambda, order_, swing, reach_.col(0), 1.0, length, kEdgeShare),
+                    modal_edge_rate(lambda, order_, swing, reach_.col(1), 2.0, angle, kEdgeShare));
+  }
+
   // The frequency of the mechanism's ringing modes at the accepted state [rad/s] (0: none).
   double ringing_rate(const ModeBlock& z) const {
     if (!(bounds_.mechanism_wh > 0.0)) return 0.0;
@@ -708,19 +746,10 @@ class ModalExponential : public Integrator {
       // A mechanism's first step (from the run's start, a load's jump or auto's relinearization):
       // the modes as they will ring about the static state of the forces there.
       const ModeBlock& ringing = starting_ && bounds_.mechanism_wh > 0.0 ? start_ringing() : z_;
-      // The modes that carry the motion, and those that could carry an element out of its
-      // range, resolved (kResolvedPhase, kEdgeShare; data.pose is the accepted state's, just
+      // The modes that could carry an element across an edge of its range or of its warnings,
+      // resolved (kResolvedPhase, kEdgeShare; data.pose is the accepted state's, just
       // evaluated); a mechanism's steps resolve its ringing modes by their own bounds.
-      // (Taken at a start about the load's static state, start_ringing, they held the first
-      // step after a step torque to a cantilever's twist mode, and its error fell to 2e-5 of
-      // rtol, below what auto is asked for; a swing set off from rest is seen from the first
-      // steps on without it.)
-      double resolved_rate = 0.0;
-      if (!(bounds_.mechanism > 0.0))
-        resolved_rate = std::max(
-            modal_resolved_rate(blocks_.lambda, order_, z_, reach_, kResolvedShare),
-            modal_edge_rate(blocks_.lambda, order_, z_, reach_,
-                            element_length_margin(context_->model, context_->data), kEdgeShare));
+      const double resolved_rate = bounds_.mechanism > 0.0 ? 0.0 : edge_rate();
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
@@ -852,6 +881,7 @@ class ModalExponential : public Integrator {
   QuasiStaticModes quasi_;
   Eigen::SparseMatrix<double> m0_;
   Eigen::VectorXd m0_a_, psi_a_;  // work space: M0 a, Phi^T M0 a
+  Eigen::ArrayXd edge_psi_a_;     // work space of edge_rate: Phi^T M0 a at the accepted state
   Block n0_;                      // N at the accepted state, when have_n0_
   bool have_n0_ = false;
   bool starting_ = true;          // no step accepted since the start or the last restart

@@ -61,38 +61,25 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
   return 0.0;
 }
 
-double modal_resolved_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                           const ModeBlock& z, const Eigen::ArrayX2d& reach, double share) {
-  double rate = 0.0;
-  for (int part = 0; part < 2; ++part) {  // the translations, the rotations
-    const auto amplitude = [&](Eigen::Index i) {
-      return lambda[i] > 0.0
-                 ? reach(i, part) * std::sqrt(z(i, 0) * z(i, 0) + z(i, 1) * z(i, 1) / lambda[i])
-                 : 0.0;
-    };
-    double total = 0.0;
-    for (Eigen::Index i = 0; i < lambda.size(); ++i) total += amplitude(i);
-    if (!(total > 0.0)) continue;
-    double above = 0.0;
-    for (Eigen::Index i : order) {
-      above += amplitude(i);
-      if (above > share * total) {
-        rate = std::max(rate, std::sqrt(lambda[i]));
-        break;
-      }
-    }
+Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& damping,
+                           const ModeBlock& z, const Eigen::ArrayXd& psi_a) {
+  Eigen::ArrayXd swing = Eigen::ArrayXd::Zero(lambda.size());
+  for (Eigen::Index i = 0; i < lambda.size(); ++i) {
+    if (!(lambda[i] > 0.0)) continue;
+    const double offset = (psi_a[i] + (damping.size() ? damping[i] * z(i, 1) : 0.0)) / lambda[i];
+    swing[i] = std::sqrt(offset * offset + z(i, 1) * z(i, 1) / lambda[i]);
   }
-  return rate;
+  return swing;
 }
 
 double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                       const ModeBlock& z, const Eigen::ArrayX2d& reach, double length,
-                       double share) {
+                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double scale,
+                       double margin, double share) {
   double above = 0.0;
   for (Eigen::Index i : order) {
     if (!(lambda[i] > 0.0)) continue;
-    above += reach(i, 0) * std::sqrt(z(i, 0) * z(i, 0) + z(i, 1) * z(i, 1) / lambda[i]);
-    if (above > share * length) return std::sqrt(lambda[i]);
+    above += scale * reach[i] * swing[i];
+    if (above > share * margin) return std::sqrt(lambda[i]);
   }
   return 0.0;
 }

@@ -126,52 +126,48 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // motion nothing in its error asks for short steps, and the range of the element laws (a
 // carriage's travel, a beam through zero length), checked at the step's evaluations, could be
 // left and regained between them: a carriage on a soft spring swinging with a 0.75 s period,
-// sampled at 0.25 s steps, dipped 30 mm out of its travel unseen (an adversarial review). So a
-// step resolves the modes that carry the motion: no longer than kResolvedPhase / w, w the
-// frequency of the slowest of the fastest oscillating modes that together hold more than
-// kResolvedShare of the sum of the modes' amplitudes in the bodies' motion (each mode's modal
-// amplitude times the largest translation, or rotation, it gives a body: a mass-normalized
-// amplitude alone undercounted a light carriage's fast swing against a heavy body's slow one
-// tenfold, and missed a 6 mm dip out of its travel; modal_resolved_rate). Its evaluations,
-// half a step apart, then lie at most pi / 16 apart in those modes' phase: an excursion they
-// miss is at most 1 - cos(pi / 32), 0.5 %, of its mode's amplitude (plus what the unresolved
-// modes carry, at most 2 kResolvedShare of the motion) - as error-controlled methods miss
-// (erk at rtol 1e-4 a 1 mm dip of a 0.25 m swing, adams 0.2 mm). Not on a mechanism, whose
-// ringing modes have their own bound (ringing_rate) and whose motion is mostly in modes of
-// lambda <= 0: a rigid mode's path between two evaluations (a carriage thrown past its travel and
-// back within a step) is not bounded by this.
+// sampled at 0.25 s steps, dipped 30 mm out of its travel unseen (an adversarial review); and
+// the warnings of the range (kSmallAngleLimit, kRailTravelWarning in
+// core/analysis/deformation_check.hpp), watched at every accepted step, could be passed and
+// regained between two (a disc twisting 0.8 rad and back). So a step resolves the modes that
+// could carry an element across the nearest of those edges: no longer than kResolvedPhase / w,
+// w the frequency of the slowest of the fastest oscillating modes whose swings together reach
+// kEdgeShare of the element's margin to it (modal_edge_rate). The margins: in length
+// (element_length_margin: a beam's axial extent, a carriage's distance to its travel's ends or
+// to its travel warning) against the modes' translations, in angle (element_angle_margin: to the
+// small-angle warning, past it to the limit of the element's measure) against twice their
+// rotations (an element's angle is the rotation of one body relative to another). A mode's
+// swing is its amplitude about the static state of the forces at the step's start, times the
+// largest translation (rotation) it gives a body (modal_swing; a mass-normalized amplitude alone
+// undercounted a light carriage's fast swing against a heavy body's slow one tenfold): over its
+// period a mode moves at most twice its swing from where it is, so the modes left unresolved
+// cannot carry an element across its margin, and the evaluations of a resolved mode, half a
+// step apart, lie at most pi / 16 apart in its phase: an excursion they miss is at most 1 -
+// cos(pi / 32), 0.5 %, of its swing. Measured about the linearization instead, a static
+// deflection counted as a swing: a cantilever twisted by a step torque had every step held
+// (1,672 steps at any rtol, its error 1e-5 of rtol). Until 2026-12-02 the steps also resolved
+// the fastest modes holding 1 % of the sum of the swings wherever the edges were: the braced
+// tower (docs/transient_measurements.md) then took 17,653 steps and 32.0 s for its 1 s at rtol
+// 1e-5 (1,884 steps and 5.4 s without). Not on a mechanism, whose ringing modes have their own
+// bound (ringing_rate) and whose motion is mostly in modes of lambda <= 0: a rigid mode's path
+// between two evaluations (a carriage thrown past its travel and back within a step) is not
+// bounded by this.
 inline constexpr double kResolvedPhase = 3.14159265358979323846 / 8.0;
-inline constexpr double kResolvedShare = 1e-2;
-
-// The frequency [rad/s] of the slowest of the fastest oscillating modes (lambda_i > 0) that
-// together hold more than `share` of the sum of their amplitudes reach_i sqrt(z_i^2 + zdot_i^2 /
-// lambda_i), the larger over the translations and the rotations: `reach` (modes x 2) each
-// mode's largest |Phi| over the bodies' translations (column 0) and rotations (column 1);
-// `order` the modes from the fastest down; 0 when no such mode moves.
-double modal_resolved_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                           const ModeBlock& z, const Eigen::ArrayX2d& reach, double share);
-
-// A share of the motion is no bound where an element is near the edge of its range: a carriage
-// swinging 5 mm at 200 rad/s, its travel's end just inside its lowest point, beside a 10 kg body
-// swinging 1 m at 3 rad/s elsewhere in the scene, was under kResolvedShare of the motion and
-// stepped over (an adversarial review). So also no longer than kResolvedPhase / w, w the
-// frequency of the slowest of the fastest oscillating modes whose translation amplitudes
-// together reach kEdgeShare of the smallest length margin of an element to its range
-// (element_length_margin in core/analysis/deformation_check.hpp: a beam's axial extent, a
-// carriage's distance to its travel's ends): the modes left unresolved cannot carry an element
-// across its margin (a swing of amplitude A moves 2 A at most). The amplitudes are taken about
-// the linearization, so a static deflection counts too (conservative). Not the angles' margins:
-// counted so (amplitudes about the linearization against 1.5 rad), a cantilever twisted by a
-// step torque had every step held (1,672 steps at any rtol, its error 1e-5 of rtol), and an
-// element nearing its angle limit turns far from the linearization, where auto relinearizes.
 inline constexpr double kEdgeShare = 0.5;
 
-// The frequency [rad/s] of the slowest of the fastest oscillating modes whose translation
-// amplitudes reach_i sqrt(z_i^2 + zdot_i^2 / lambda_i) (reach column 0) together pass `share`
-// times `length`; 0 when none do.
+// Each oscillating mode's amplitude about the static state of the forces at the state z (column
+// 0 displacements, 1 velocities): sqrt(((psi_a_i + c_i zdot_i) / lambda_i)^2 + zdot_i^2 /
+// lambda_i), psi_a = Phi^T M0 a the modal accelerations there, c_i the mode's damping (empty:
+// none); 0 for lambda_i <= 0.
+Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& damping,
+                           const ModeBlock& z, const Eigen::ArrayXd& psi_a);
+
+// The frequency [rad/s] of the slowest of the fastest oscillating modes whose swings
+// `scale` reach_i swing_i together pass `share` times `margin`; `order` the modes from the fastest
+// down; 0 when none do.
 double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                       const ModeBlock& z, const Eigen::ArrayX2d& reach, double length,
-                       double share);
+                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double scale,
+                       double margin, double share);
 
 // z for the bounds of a step from a state where the forces may set modes ringing that do not
 // ring yet (a mechanism's first step, at the start or at a load's jump): each mode's

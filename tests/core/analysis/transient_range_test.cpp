@@ -237,8 +237,9 @@ TEST(TransientRange, TwoModesLeavingTheTravelTogetherBetweenOutputsEndTheRun) {
 // 10 kg body on a 10 m soft beam swinging 1 m at 3 rad/s elsewhere in the scene: with travel
 // [0.2955, 5] m the carriage leaves it at asin(0.9) / 200 = 0.0055988 s. Its swing is under 1 %
 // of the scene's motion, and the modal method, whose steps resolved only the modes carrying
-// that share, stepped over it (4 steps in 0.5 s, ok; an adversarial review). The steps now also
-// resolve the modes that could carry an element across half its margin (kEdgeShare). With
+// that share, stepped over it (4 steps in 0.5 s, ok; an adversarial review). The steps now
+// resolve the modes that could carry an element across half its margin (kEdgeShare; the share
+// of the motion is no longer a bound, core/analysis/modal_step_bounds.hpp). With
 // travel [0.2945, 5] (0.5 mm below the carriage's lowest point) the run goes through.
 TEST(TransientRange, ASmallSwingNearItsEdgeBesideALargeMotionElsewhereEndsTheRun) {
   const double area = 3.14159265358979 * 0.01 * 0.01;

@@ -12,8 +12,12 @@
 #include <string>
 #include <vector>
 
+#include "core/analysis/deformation_check.hpp"
 #include "core/analysis/transient.hpp"
+#include "core/model/data.hpp"
+#include "core/model/element_kinematics.hpp"
 #include "tests/support/scene_builder.hpp"
+#include "tests/support/scenes.hpp"
 #include "tests/support/transient_run.hpp"
 
 namespace beamrail {
@@ -47,6 +51,38 @@ std::vector<std::string> warnings_with(const TransientResult& r, const std::stri
 double number_after(const std::string& text, const std::string& key) {
   const size_t at = text.find(key);
   return at == std::string::npos ? std::nan("") : std::atof(text.c_str() + at + key.size());
+}
+
+// The margins the modal method's steps resolve (core/analysis/modal_step_bounds.hpp), in
+// configurations set by hand: a disc twisted theta on a 1 m shaft is 0.5 - theta from the
+// small-angle warning, past it min(limit - theta, theta / 10); a carriage x from point 1 of a rail
+// without a travel, 0.01 m at the start, is 0.1 - x from its warning, past it x / 10; the shaft's
+// axial extent (1 m) is the other length margin.
+TEST(RangeWarnings, TheMarginsToTheEdgesAreTheirClosedForms) {
+  Scene s;
+  s.material("steel", kE, kG).circle("rod", 0.02);
+  s.body("disc", 1.0, Vec3(1e-4, 1e-4, 1e-4), Vec3(1, 0, 0));
+  s.body("carriage", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.01, 0, 0));
+  s.beam("shaft", "ground", "disc", Vec3::Zero(), Vec3(1, 0, 0), "steel", "rod");
+  s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.01, 0, 0), "steel",
+         "rod");
+  const Model model = s.model();
+  const double limit = angle_limit(rotation_measure(model.beams.at(0)));
+  const int disc = testing::body_index(model, "disc");
+  const int carriage = testing::body_index(model, "carriage");
+  Data data(model);
+  EXPECT_NEAR(element_angle_margin(model, data), kSmallAngleLimit, 1e-12);
+  EXPECT_NEAR(element_length_margin(model, data), 0.09, 1e-12);
+  for (const double theta : {0.3, 0.7, 1.45}) {
+    data.pose[disc].A = Eigen::AngleAxisd(theta, Vec3::UnitX()).toRotationMatrix();
+    const double expected = theta < 0.5 ? 0.5 - theta : std::min(limit - theta, 0.1 * theta);
+    EXPECT_NEAR(element_angle_margin(model, data), expected, 1e-9) << theta;
+  }
+  for (const double x : {0.05, 0.2, 20.0}) {
+    data.pose[carriage].u = Vec3(x - 0.01, 0, 0);
+    const double expected = std::min(1.0, x < 0.1 ? 0.1 - x : 0.1 * x);
+    EXPECT_NEAR(element_length_margin(model, data), expected, 1e-12) << x;
+  }
 }
 
 // A disc of polar inertia 1e-4 on a 1 m massless steel shaft (10 mm square, G Ix / L = 114 N m)

@@ -120,11 +120,12 @@ class ModalExponential : public Integrator {
     std::sort(order_.begin(), order_.end(), [&](Eigen::Index a, Eigen::Index b) {
       return blocks_.lambda[a] > blocks_.lambda[b];
     });
-    // How far each mode moves a body per unit of its coordinate, in translation and rotation.
-    reach_ = Eigen::ArrayX2d::Zero(m_, 2);
-    for (Eigen::Index i = 0; i < m_; ++i)
-      for (Eigen::Index r = 0; r < n_; ++r)
-        reach_(i, (r % kD) / 3) = std::max(reach_(i, (r % kD) / 3), std::abs(phi_(r, i)));
+    // How far each mode moves the elements per unit of its coordinate, in length and angle.
+    {
+      Data at_reference(model);
+      set_state(model, at_reference, reference.data());
+      reach_ = element_reach(model, at_reference, phi_);
+    }
     bounds_ = ModalStepBounds(
         o.rtol,
         blocks_.lambda.size() > 0 ? std::sqrt(std::max(blocks_.lambda.maxCoeff(), 0.0)) : 0.0,
@@ -250,22 +251,21 @@ class ModalExponential : public Integrator {
         edge_psi_a_[i] = n0_(i, 1) - lambda[i] * z_(i, 0) - damping(i);
     } else {
       const double a_norm = std::sqrt(std::max(acceleration_.dot(m0_v_), 0.0));
-      double translation = 0.0, rotation = 0.0;
+      double length_swing = 0.0, angle_swing = 0.0;
       for (Eigen::Index i = 0; i < m_; ++i) {
         if (!(lambda[i] > 0.0)) continue;
         const double swing =
             (a_norm + std::abs(damping(i))) / lambda[i] + std::abs(z_(i, 1)) / std::sqrt(lambda[i]);
-        translation += reach_(i, 0) * swing;
-        rotation += reach_(i, 1) * swing;
+        length_swing += reach_(i, 0) * swing;
+        angle_swing += reach_(i, 1) * swing;
       }
-      if (!(translation > kEdgeShare * length) && !(2.0 * rotation > kEdgeShare * angle))
-        return 0.0;
+      if (!(length_swing > kEdgeShare * length) && !(angle_swing > kEdgeShare * angle)) return 0.0;
       multiply_transposed(phi_, m0_v_.data(), edge_psi_a_.data());
     }
     const Eigen::ArrayXd swing =
         modal_swing(lambda, blocks_.damped() ? blocks_.damping : Eigen::ArrayXd(), z_, edge_psi_a_);
-    return std::max(modal_edge_rate(lambda, order_, swing, reach_.col(0), 1.0, length, kEdgeShare),
-                    modal_edge_rate(lambda, order_, swing, reach_.col(1), 2.0, angle, kEdgeShare));
+    return std::max(modal_edge_rate(lambda, order_, swing, reach_.col(0), length, kEdgeShare),
+                    modal_edge_rate(lambda, order_, swing, reach_.col(1), angle, kEdgeShare));
   }
 
   // The frequency of the mechanism's ringing modes at the accepted state [rad/s] (0: none).
@@ -891,9 +891,9 @@ class ModalExponential : public Integrator {
   InitialLinearization initial_;  // why the initial state was linearized about (modal_reference)
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
   Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
-  Eigen::ArrayX2d reach_;         // each mode's largest |Phi| over the translations, the rotations
-  Eigen::VectorXd m0_v_;          // work space of project
-  ModeBlocks blocks_;  // the modes' linear part: eigenvalues and damping (exponential_step.hpp)
+  Eigen::ArrayX2d reach_;  // element_reach: each mode's largest change of an element's xi, angle
+  Eigen::VectorXd m0_v_;   // work space of project
+  ModeBlocks blocks_;      // the modes' linear part: eigenvalues and damping (exponential_step.hpp)
   double damping_coupling_ = 0.0;  // modal_damping: the damping left in N, per mode velocity
   ModalCoordinates coordinates_;   // the bodies' offsets from the linearization and back
   Block z_, x_;                    // the accepted state, modal and physical (x_ = Phi z_)

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/analysis/modal_coordinates.hpp"
+#include "core/model/element_kinematics.hpp"
 
 namespace beamrail {
 
@@ -61,6 +62,38 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
   return 0.0;
 }
 
+Eigen::ArrayX2d element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi) {
+  struct Lever {
+    int row1, row2;  // the first of the bodies' 6 rows in phi; -1: fixed
+    Vec3 arm1, arm2, span;
+  };
+  std::vector<Lever> levers;
+  const auto add = [&](const ElementEnds& ends, RotationMeasure measure) {
+    const ElementFrames<double> f =
+        element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], measure);
+    const auto row = [&model](int body) {
+      const int free = model.bodies[body].free_index;
+      return free >= 0 ? kDofsPerBody * free : -1;
+    };
+    levers.push_back({row(ends.body1), row(ends.body2), f.R1, f.R2, f.lever1 - f.R1});
+  };
+  for (const Beam& e : model.beams) add(e.ends, rotation_measure(e));
+  for (const Rail& e : model.rails) add(e.ends, rotation_measure(e));
+  Eigen::ArrayX2d reach = Eigen::ArrayX2d::Zero(phi.cols(), 2);
+  for (Eigen::Index i = 0; i < phi.cols(); ++i)
+    for (const Lever& l : levers) {
+      const auto part = [&](int row, int offset) {
+        return row >= 0 ? Vec3(phi.col(i).segment<3>(row + offset)) : Vec3::Zero();
+      };
+      const Vec3 turn1 = part(l.row1, 3), turn2 = part(l.row2, 3);
+      const Vec3 p1 = part(l.row1, 0) + turn1.cross(l.arm1);
+      const Vec3 p2 = part(l.row2, 0) + turn2.cross(l.arm2);
+      reach(i, 0) = std::max(reach(i, 0), (p2 - p1 - turn1.cross(l.span)).norm());
+      reach(i, 1) = std::max(reach(i, 1), (turn2 - turn1).norm());
+    }
+  return reach;
+}
+
 Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& damping,
                            const ModeBlock& z, const Eigen::ArrayXd& psi_a) {
   Eigen::ArrayXd swing = Eigen::ArrayXd::Zero(lambda.size());
@@ -73,12 +106,12 @@ Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& d
 }
 
 double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double scale,
-                       double margin, double share) {
+                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double margin,
+                       double share) {
   double above = 0.0;
   for (Eigen::Index i : order) {
     if (!(lambda[i] > 0.0)) continue;
-    above += scale * reach[i] * swing[i];
+    above += reach[i] * swing[i];
     if (above > share * margin) return std::sqrt(lambda[i]);
   }
   return 0.0;

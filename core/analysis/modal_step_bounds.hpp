@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/analysis/exponential_step.hpp"
+#include "core/model/data.hpp"
 #include "core/model/model.hpp"
 
 namespace beamrail {
@@ -134,26 +135,36 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // w the frequency of the slowest of the fastest oscillating modes whose swings together reach
 // kEdgeShare of the element's margin to it (modal_edge_rate). The margins: in length
 // (element_length_margin: a beam's axial extent, a carriage's distance to its travel's ends or
-// to its travel warning) against the modes' translations, in angle (element_angle_margin: to the
-// small-angle warning, past it to the limit of the element's measure) against twice their
-// rotations (an element's angle is the rotation of one body relative to another). A mode's
-// swing is its amplitude about the static state of the forces at the step's start, times the
-// largest translation (rotation) it gives a body (modal_swing; a mass-normalized amplitude alone
-// undercounted a light carriage's fast swing against a heavy body's slow one tenfold): over its
-// period a mode moves at most twice its swing from where it is, so the modes left unresolved
-// cannot carry an element across its margin, and the evaluations of a resolved mode, half a
-// step apart, lie at most pi / 16 apart in its phase: an excursion they miss is at most 1 -
-// cos(pi / 32), 0.5 %, of its swing. Measured about the linearization instead, a static
-// deflection counted as a swing: a cantilever twisted by a step torque had every step held
-// (1,672 steps at any rtol, its error 1e-5 of rtol). Until 2026-12-02 the steps also resolved
-// the fastest modes holding 1 % of the sum of the swings wherever the edges were: the braced
-// tower (docs/transient_measurements.md) then took 17,653 steps and 32.0 s for its 1 s at rtol
-// 1e-5 (1,884 steps and 5.4 s without). Not on a mechanism, whose ringing modes have their own
-// bound (ringing_rate) and whose motion is mostly in modes of lambda <= 0: a rigid mode's path
-// between two evaluations (a carriage thrown past its travel and back within a step) is not
-// bounded by this.
+// to its travel warning), in angle (element_angle_margin: to the small-angle warning, past it to
+// the limit of the element's measure). A mode's swing is its amplitude about the static state of
+// the forces at the step's start (modal_swing) times the largest change it makes in an element's
+// point 2 relative to its left end, or in its relative rotation (element_reach): counted as the
+// largest translation it gives a body, a twist that swung a rail's point 2.9 m from its body's
+// centre counted as no motion, and a rail between two bodies swinging against each other as half
+// its motion, and both left their travels between two steps, ok (an adversarial review). Over
+// its period a mode moves at most twice its swing from where it is, so the modes left unresolved
+// cannot carry an element across its margin, and the evaluations of a resolved mode, half a step
+// apart, lie at most pi / 16 apart in its phase: an excursion they miss is at most 1 - cos(pi /
+// 32), 0.5 %, of its swing. (About the linearization instead, a static deflection would count as
+// a swing, and an element held near an edge would have every step held.) Until 2026-12-02 the
+// steps resolved the fastest modes holding 1 % of the sum of the swings wherever the edges were:
+// the braced tower (docs/transient_measurements.md) then took 17,653 steps and 32.0 s for its 1 s
+// at rtol 1e-5 (1,884 steps and 5.4 s without). Not on a mechanism, whose ringing modes have
+// their own bound (ringing_rate) and whose motion is mostly in modes of lambda <= 0: a rigid
+// mode's path between two evaluations (a carriage thrown past its travel and back within a step)
+// is not bounded by this.
 inline constexpr double kResolvedPhase = 3.14159265358979323846 / 8.0;
 inline constexpr double kEdgeShare = 0.5;
+
+// How far each mode moves the elements per unit of its coordinate (modes x 2): column 0 the
+// largest first-order change |d xi| of an element's point 2 in its left-end frame, xi = E1^T (p2 -
+// p1), column 1 the largest change |d theta_2 - d theta_1| of its relative rotation, over the beams
+// and rails: d xi = d p2 - d p1 - d theta_1 x (p2 - p1), d p_k = d c_k + d theta_k x R_k (R_k the
+// centre -> point k arm), from each body's offsets (d c, d theta) in `phi` (6 rows per free body,
+// core/analysis/modal_coordinates.hpp; fixed bodies do not move) about the configuration of
+// data.pose. In a frame that turns with a floating part both ends turn with it: the lengths are
+// the same.
+Eigen::ArrayX2d element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi);
 
 // Each oscillating mode's amplitude about the static state of the forces at the state z (column
 // 0 displacements, 1 velocities): sqrt(((psi_a_i + c_i zdot_i) / lambda_i)^2 + zdot_i^2 /
@@ -163,11 +174,11 @@ Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& d
                            const ModeBlock& z, const Eigen::ArrayXd& psi_a);
 
 // The frequency [rad/s] of the slowest of the fastest oscillating modes whose swings
-// `scale` reach_i swing_i together pass `share` times `margin`; `order` the modes from the fastest
-// down; 0 when none do.
+// reach_i swing_i together pass `share` times `margin`; `order` the modes from the fastest down;
+// 0 when none do.
 double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double scale,
-                       double margin, double share);
+                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double margin,
+                       double share);
 
 // z for the bounds of a step from a state where the forces may set modes ringing that do not
 // ring yet (a mechanism's first step, at the start or at a load's jump): each mode's

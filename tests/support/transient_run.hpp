@@ -96,6 +96,15 @@ inline TransientOptions options(double t_end, double output_step, double rtol, d
   return o;
 }
 
+// A run of `method` ("auto", "modal", "bdf" ...) at rtol 1e-8, atol 1e-10, stopped after 60 s
+// (a guard: the range tests' runs end in well under a second).
+inline TransientOptions range_options(const std::string& method, double t_end, double output_step) {
+  TransientOptions o = options(t_end, output_step, 1e-8, 1e-10);
+  o.integrator.method = *method_from_name(method);
+  o.max_seconds = 60.0;
+  return o;
+}
+
 // A tight reference run: explicit Verner 8(7) at rtol (atol 1e-2 rtol).
 inline TransientRun tight(const Model& model, double t_end, double output_step,
                           double rtol = 1e-11) {

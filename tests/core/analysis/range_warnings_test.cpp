@@ -28,17 +28,6 @@ using testing::simulate;
 constexpr double kE = 2.1e11, kG = 8.0769e10, kPi = 3.14159265358979;
 const std::vector<std::string> kMethods = {"auto", "modal", "bdf", "adams", "dirk", "erk"};
 
-TransientOptions options(const std::string& method, double t_end, double output_step) {
-  TransientOptions o;
-  o.t_end = t_end;
-  o.output_step = output_step;
-  o.integrator.method = *method_from_name(method);
-  o.integrator.rtol = 1e-8;
-  o.integrator.atol = 1e-10;
-  o.max_seconds = 60.0;  // a guard: every run here ends in well under a second
-  return o;
-}
-
 // The warnings that contain `what`.
 std::vector<std::string> warnings_with(const TransientResult& r, const std::string& what) {
   std::vector<std::string> out;
@@ -100,7 +89,8 @@ TEST(RangeWarnings, ATwistPastTheSmallAngleRangeBetweenRowsIsWarnedOf) {
       s.body("disc", 1.0, Vec3(1e-4, 1e-2, 1e-2), Vec3(1, 0, 0));
       s.last_body()["angular_velocity"] = testing::vec(amplitude * w, 0, 0);
       s.beam("shaft", "ground", "disc", Vec3::Zero(), Vec3(1, 0, 0), "steel", "sq10");
-      const auto run = simulate(s.model(), options(method, 4 * half_period, half_period));
+      const auto run =
+          simulate(s.model(), testing::range_options(method, 4 * half_period, half_period));
       ASSERT_TRUE(run.result.ok) << method << ": " << run.result.message;
       // The rows see no twist: the closed form is at its zeros there.
       double at_rows = 0.0;
@@ -145,7 +135,7 @@ TEST(RangeWarnings, ACarriageFarOutOnARailWithoutATravelBetweenRowsIsWarnedOf) {
            "rod");
     s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.01, 0, 0), "soft", "rod");
     s.force("carriage", Vec3(14.4, 0, 0));
-    TransientOptions o = options(method, 2 * period, period);
+    TransientOptions o = testing::range_options(method, 2 * period, period);
     o.integrator.rtol = 1e-6;
     o.integrator.atol = 1e-9;
     const auto run = simulate(s.model(), o);

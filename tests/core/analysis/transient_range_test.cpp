@@ -12,6 +12,7 @@
 
 #include "core/analysis/transient.hpp"
 #include "tests/support/scene_builder.hpp"
+#include "tests/support/scenes.hpp"
 #include "tests/support/transient_run.hpp"
 
 namespace beamrail {
@@ -20,17 +21,6 @@ namespace {
 using testing::Scene;
 using testing::simulate;
 constexpr double kE = 2.1e11, kG = 8.0769e10;
-
-TransientOptions options(const std::string& method, double t_end, double output_step) {
-  TransientOptions o;
-  o.t_end = t_end;
-  o.output_step = output_step;
-  o.integrator.method = *method_from_name(method);
-  o.integrator.rtol = 1e-8;
-  o.integrator.atol = 1e-10;
-  o.max_seconds = 60.0;  // a guard: every run here ends in well under a second
-  return o;
-}
 
 // A 1 m massless steel shaft (10 mm square, G Ix = 114 N m) holding a disc of polar inertia 1e-4
 // spun about the shaft's axis at w0: it twists by up to w0 sqrt(J L / G Ix) (3.75 rad for 4000
@@ -45,7 +35,7 @@ TEST(TransientRange, ShaftTwistedBeyondTheLawsRangeEndsTheRun) {
       s.last_body()["angular_velocity"] = testing::vec(w0, 0, 0);
       s.beam("shaft", "ground", "disc", Vec3::Zero(), Vec3(1, 0, 0), "steel", "sq10");
       const Model model = s.model();
-      const auto run = simulate(model, options(method, 0.02, 1e-4));
+      const auto run = simulate(model, testing::range_options(method, 0.02, 1e-4));
       double drift = 0.0;
       const double e0 = run.samples.front().sample.energy();
       for (const auto& snap : run.samples)
@@ -80,7 +70,7 @@ TEST(TransientRange, BeamCompressedThroughZeroLengthEndsTheRun) {
     s.body("block", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.1, 0, 0));
     s.last_body()["velocity"] = testing::vec(-v0, 0, 0);
     s.beam("strut", "ground", "block", Vec3::Zero(), Vec3(0.1, 0, 0), "steel", "sq10");
-    const auto run = simulate(s.model(), options("bdf", 2e-4, 1e-6));
+    const auto run = simulate(s.model(), testing::range_options("bdf", 2e-4, 1e-6));
     double closest = 1.0;
     for (const auto& snap : run.samples) closest = std::min(closest, snap.c[1].x());
     std::printf("v0 = %.0f m/s: %s, closest approach %.4f m%s%s\n", v0,
@@ -110,7 +100,7 @@ TEST(TransientRange, CarriageLeavingItsTravelEndsTheRun) {
     s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.4, 0, 0), "steel",
            "rod");
     if (travel) s.last_rail()["travel"] = {0.0, 0.5};
-    const auto run = simulate(s.model(), options("bdf", 0.2, 1e-3));
+    const auto run = simulate(s.model(), testing::range_options("bdf", 0.2, 1e-3));
     std::printf("travel %s: %s at t = %.4f s, carriage at %.3f m%s%s\n",
                 travel ? "[0, 0.5]" : "none", run.result.ok ? "ok" : "failed", run.result.t_reached,
                 run.samples.back().c[1].x(), run.result.ok ? "" : ": ", run.result.message.c_str());
@@ -160,7 +150,7 @@ TEST(TransientRange, CarriageLeavingItsTravelBetweenOutputsEndsTheRun) {
                "rod");
         s.last_rail()["travel"] = {c.low, 0.6};
         s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "soft", "rod");
-        TransientOptions o = options(method, 0.5, 0.25);
+        TransientOptions o = testing::range_options(method, 0.5, 0.25);
         o.integrator.rtol = rtol;
         o.integrator.atol = 1e-3 * rtol;
         const auto run = simulate(s.model(), o);
@@ -210,7 +200,7 @@ TEST(TransientRange, TwoModesLeavingTheTravelTogetherBetweenOutputsEndTheRun) {
     s.last_rail()["travel"] = {0.0805, 5.0};
     s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "s1", "rod");
     s.beam("link", "carriage", "heavy", Vec3(0.3, 0, 0), Vec3(0.6, 0, 0), "s2", "rod");
-    TransientOptions o = options(method, 0.5, output_step);
+    TransientOptions o = testing::range_options(method, 0.5, output_step);
     o.integrator.rtol = rtol;
     o.integrator.atol = 1e-3 * rtol;
     return simulate(s.model(), o);
@@ -261,7 +251,7 @@ TEST(TransientRange, ASmallSwingNearItsEdgeBesideALargeMotionElsewhereEndsTheRun
         s.last_rail()["travel"] = {low, 5.0};
         s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "sc", "rod");
         s.beam("hold", "ground", "heavy", Vec3(0, 2, 0), Vec3(10, 2, 0), "sh", "rod");
-        TransientOptions o = options(method, 0.5, 0.25);
+        TransientOptions o = testing::range_options(method, 0.5, 0.25);
         o.integrator.rtol = rtol;
         o.integrator.atol = 1e-3 * rtol;
         const auto run = simulate(s.model(), o);
@@ -298,7 +288,7 @@ TEST(TransientRange, ACarriagePushedFromRestLeavesItsTravelBetweenOutputs) {
     s.last_rail()["travel"] = {0.1, 0.6};
     s.beam("spring", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "soft", "rod");
     s.force("carriage", Vec3(-18.0, 0, 0));
-    TransientOptions o = options(method, 1.0, 0.5);
+    TransientOptions o = testing::range_options(method, 1.0, 0.5);
     o.integrator.rtol = 1e-6;
     o.integrator.atol = 1e-9;
     const auto run = simulate(s.model(), o);
@@ -308,6 +298,87 @@ TEST(TransientRange, ACarriagePushedFromRestLeavesItsTravelBetweenOutputs) {
     EXPECT_FALSE(run.result.ok) << method;
     EXPECT_NE(run.result.message.find("left the rail"), std::string::npos) << method;
     EXPECT_NEAR(run.result.t_reached, std::acos(-0.6) / 12.0, 1e-3) << method;
+  }
+}
+
+// What the modal steps count as an element's motion is how far a mode moves its point 2
+// relative to its left end (element_reach), not how far it moves a body: two scenes where the
+// bodies' own motion is small or half of it, each left its travel between two steps of the modal
+// method, ok in 1 step (an adversarial review). Both now fail at the closed form's time.
+//  - A rocker (I = 1 about z) on a pivot soft in twist (G Ix / L = 100 N m/rad, w = 10 rad/s),
+//    turning theta = 0.01 sin(10 t), carries a rail whose point 1 is 2.9 m from its centre; the
+//    carriage is fixed 0.3 m along it: xi = 0.3 cos(theta) + 2.9 sin(theta), which reaches the
+//    travel's 0.28 m as the rocker first turns back past theta_0 (0.3 cos + 2.9 sin = 0.28).
+//    The rocker's centre does not move.
+//  - Two 1 kg bodies 0.3 m apart on 100 N/m springs to the ground and a 50 N/m coupling, pushed
+//    apart by 2 N each and thrown together at 0.0849 m/s: their distance d = 0.32 - 0.02 cos(w t)
+//    - 0.012 sin(w t), w = sqrt(200), reaches the travel's 0.33 m of the rail between them at
+//    (alpha + acos(-0.01 / 0.023324)) / w, alpha = atan2(0.012, 0.02); each body moves half that.
+TEST(TransientRange, AnElementsMotionIsItsEndsRelativeMotionNotABodys) {
+  const std::string lever = R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"pivot": {"shape": "custom", "S": 3.14e-4, "Ix": 1.238098775520311e-10,
+                           "Iy": 7.85e-9, "Iz": 7.85e-9},
+                 "soft": {"shape": "custom", "S": 1e-4, "Ix": 1e-16, "Iy": 1e-16, "Iz": 1e-16}},
+    "bodies": [{"name": "rocker", "mass": 1, "inertia": [1, 1, 1], "position": [0, 0, 0],
+                "angular_velocity": [0, 0, 0.1]}],
+    "beams": [{"name": "pivot", "body1": "ground", "body2": "rocker", "point1": [0, 0, -0.1],
+               "point2": [0, 0, 0], "point3": [1, 0, -0.1], "material": "steel",
+               "section": "pivot"}],
+    "rails": [{"name": "guide", "type": "prismatic", "body1": "rocker", "body2": "ground",
+               "point1": [0, 2.9, 0], "point2": [0.3, 2.9, 0], "point3": [0, 3.9, 0],
+               "material": "steel", "section": "soft", "travel": [0.28, 0.6]}]})";
+  const std::string pair = R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10}, "coupling": {"E": 1.5e5, "G": 5.77e4},
+                  "soft": {"E": 3e5, "G": 1.15e5}},
+    "sections": {"rod": {"shape": "custom", "S": 1e-4, "Ix": 0.011, "Iy": 0.0055, "Iz": 0.0055},
+                 "rod20": {"shape": "circle", "diameter": 0.02}},
+    "bodies": [{"name": "A", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [0.3, 0, 0],
+                "velocity": [0.08485281374238571, 0, 0]},
+               {"name": "B", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [0.6, 0, 0],
+                "velocity": [-0.08485281374238571, 0, 0]}],
+    "beams": [{"name": "s1", "body1": "ground", "body2": "A", "point1": [0, 0, 0],
+               "point2": [0.3, 0, 0], "point3": [0, 1, 0], "material": "soft", "section": "rod"},
+              {"name": "s2", "body1": "B", "body2": "ground", "point1": [0.6, 0, 0],
+               "point2": [0.9, 0, 0], "point3": [0.6, 1, 0], "material": "soft", "section": "rod"},
+              {"name": "c", "body1": "A", "body2": "B", "point1": [0.3, 0, 0],
+               "point2": [0.6, 0, 0], "point3": [0.3, 1, 0], "material": "coupling",
+               "section": "rod"}],
+    "rails": [{"name": "guide", "type": "prismatic", "body1": "A", "body2": "B",
+               "point1": [0.3, 0, 0], "point2": [0.6, 0, 0], "point3": [0.3, 1, 0],
+               "material": "steel", "section": "rod20", "travel": [0, 0.33]}],
+    "loads": [{"type": "force", "body": "A", "value": [-2, 0, 0]},
+              {"type": "force", "body": "B", "value": [2, 0, 0]}]})";
+  // theta_0 < 0 where 0.3 cos + 2.9 sin = 0.28, by Newton's method from the small-angle root.
+  double theta0 = -0.02 / 2.9;
+  for (int i = 0; i < 20; ++i)
+    theta0 -= (0.3 * std::cos(theta0) + 2.9 * std::sin(theta0) - 0.28) /
+              (-0.3 * std::sin(theta0) + 2.9 * std::cos(theta0));
+  const double w = std::sqrt(200.0);
+  const struct {
+    const char* label;
+    std::string scene;
+    double t_end, exit;
+  } cases[] = {{"rocker", lever, 2.0, (3.14159265358979 + std::asin(-theta0 / 0.01)) / 10.0},
+               {"pair", pair, 1.0,
+                (std::atan2(0.012, 0.02) + std::acos(-0.01 / std::hypot(0.02, 0.012))) / w}};
+  for (const auto& c : cases) {
+    const Model model = testing::scene_from_json(c.scene);
+    for (const std::string method : {"auto", "modal"}) {
+      for (const double rtol : {1e-6, 1e-10}) {
+        TransientOptions o = testing::range_options(method, c.t_end, c.t_end);
+        o.integrator.rtol = rtol;
+        o.integrator.atol = 1e-3 * rtol;
+        const auto run = simulate(model, o);
+        std::printf("%s, %s, rtol %.0e: %s at t = %.5f s (closed form %.5f s), %ld steps\n",
+                    c.label, method.c_str(), rtol, run.result.ok ? "ok" : "failed",
+                    run.result.t_reached, c.exit, run.result.stats.steps);
+        EXPECT_FALSE(run.result.ok) << c.label << " " << method;
+        EXPECT_NE(run.result.message.find("left the rail"), std::string::npos)
+            << run.result.message;
+        EXPECT_NEAR(run.result.t_reached, c.exit, 1e-3) << c.label << " " << method;
+      }
+    }
   }
 }
 

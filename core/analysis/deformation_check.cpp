@@ -80,33 +80,48 @@ std::string element_out_of_range(const Model& model, const Data& data, double fr
   return "";
 }
 
-double element_length_margin(const Model& model, const Data& data) {
-  double margin = std::numeric_limits<double>::infinity();
-  for (const Beam& e : model.beams)
-    margin = std::min(margin, frames(e.ends, data, rotation_measure(e)).xi(0));
-  for (const Rail& e : model.rails) {
-    const double x = frames(e.ends, data, rotation_measure(e)).xi(0);
-    if (std::isfinite(e.travel_min) || std::isfinite(e.travel_max))
-      margin = std::min({margin, x - e.travel_min, e.travel_max - x});
-    else if (const double m = kRailTravelWarning * e.ends.length - std::abs(x); m > 0.0)
-      margin = std::min(margin, m);
-    else
-      margin = std::min(margin, kWarnedMargin * std::abs(x));
+ElementMargins element_margins(const Model& model, const Data& data) {
+  ElementMargins out;
+  const auto angle_margin = [](const ElementFrames<double>& f, RotationMeasure measure) {
+    const double angle = element_angle(f, measure);
+    return angle < kSmallAngleLimit ? kSmallAngleLimit - angle
+                                    : std::min(angle_limit(measure) - angle, kWarnedMargin * angle);
+  };
+  for (const Beam& e : model.beams) {
+    const RotationMeasure measure = rotation_measure(e);
+    const ElementFrames<double> f = frames(e.ends, data, measure);
+    out.length.push_back(f.xi(0));
+    out.angle.push_back(angle_margin(f, measure));
   }
-  return margin;
+  for (const Rail& e : model.rails) {
+    const RotationMeasure measure = rotation_measure(e);
+    const ElementFrames<double> f = frames(e.ends, data, measure);
+    const double x = f.xi(0);
+    double margin = std::numeric_limits<double>::infinity();
+    if (std::isfinite(e.travel_min) || std::isfinite(e.travel_max))
+      margin = std::min(x - e.travel_min, e.travel_max - x);
+    else if (const double m = kRailTravelWarning * e.ends.length - std::abs(x); m > 0.0)
+      margin = m;
+    else
+      margin = kWarnedMargin * std::abs(x);
+    if (e.min_length > 0.0 && std::abs(x) > e.min_length)
+      margin = std::min(margin, std::abs(x) - e.min_length);
+    out.length.push_back(margin);
+    out.angle.push_back(angle_margin(f, measure));
+  }
+  return out;
+}
+
+double element_length_margin(const Model& model, const Data& data) {
+  const std::vector<double> m = element_margins(model, data).length;
+  return m.empty() ? std::numeric_limits<double>::infinity()
+                   : *std::min_element(m.begin(), m.end());
 }
 
 double element_angle_margin(const Model& model, const Data& data) {
-  double margin = std::numeric_limits<double>::infinity();
-  const auto add = [&margin](const ElementEnds& ends, const Data& d, RotationMeasure measure) {
-    const double angle = element_angle(frames(ends, d, measure), measure);
-    margin = std::min(margin, angle < kSmallAngleLimit
-                                  ? kSmallAngleLimit - angle
-                                  : std::min(angle_limit(measure) - angle, kWarnedMargin * angle));
-  };
-  for (const Beam& e : model.beams) add(e.ends, data, rotation_measure(e));
-  for (const Rail& e : model.rails) add(e.ends, data, rotation_measure(e));
-  return margin;
+  const std::vector<double> m = element_margins(model, data).angle;
+  return m.empty() ? std::numeric_limits<double>::infinity()
+                   : *std::min_element(m.begin(), m.end());
 }
 
 std::string element_turned_beyond(const Model& model, const Data& data, double limit) {

@@ -38,17 +38,21 @@ inline constexpr double kWarnedMargin = 0.1;
 // finds elements near the edge).
 std::string element_out_of_range(const Model& model, const Data& data, double fraction = 1.0);
 
-// How near the elements are to the edges of their laws' ranges in length, in the configuration
-// of data.pose: the smallest distance [m] of a beam's axial extent from zero, of a carriage from
-// its travel's ends and, on a rail without a travel, of a carriage inside kRailTravelWarning
-// times its initial distance from that distance (beyond it, kWarnedMargin of its distance);
-// infinity where no element has such an edge.
-double element_length_margin(const Model& model, const Data& data);
+// How near each element (the beams, then the rails) is to the edges of its law's range and of
+// its warnings, in the configuration of data.pose:
+//  - length [m]: a beam's axial extent; a carriage's distance to its travel's ends, or on a rail
+//    without a travel to kRailTravelWarning times its initial distance (beyond it, kWarnedMargin
+//    of its distance), and to its min_length while above it (infinity: none);
+//  - angle [rad]: the element's angle (element_angle) to the next edge above it, kSmallAngleLimit
+//    while below it, else the limit of its measure (angle_limit) and at most kWarnedMargin of
+//    the angle.
+struct ElementMargins {
+  std::vector<double> length, angle;
+};
+ElementMargins element_margins(const Model& model, const Data& data);
 
-// How near the elements are to the edges of their angles, in the configuration of data.pose: the
-// smallest distance [rad] of an element's angle (element_angle) from the next edge above it:
-// kSmallAngleLimit while it is below it, else the limit of its measure (angle_limit), and then
-// at most kWarnedMargin of the angle; infinity without elements.
+// The smallest of element_margins' lengths, of its angles; infinity without elements.
+double element_length_margin(const Model& model, const Data& data);
 double element_angle_margin(const Model& model, const Data& data);
 
 // The first element whose relative rotation (the angle of E1^T E2 in [0, pi]; for a cylindrical

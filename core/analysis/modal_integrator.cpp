@@ -238,9 +238,10 @@ class ModalExponential : public Integrator {
   // the swings (|psi_a_i| <= |a|_M0, the modes mass-normalized) does not already rule the edges
   // out (the braced tower: never).
   double edge_rate() {
-    const Model& model = context_->model;
-    const double length = element_length_margin(model, context_->data);
-    const double angle = element_angle_margin(model, context_->data);
+    const ElementMargins margins = element_margins(context_->model, context_->data);
+    if (margins.length.empty()) return 0.0;
+    const double length = *std::min_element(margins.length.begin(), margins.length.end());
+    const double angle = *std::min_element(margins.angle.begin(), margins.angle.end());
     const Eigen::ArrayXd& lambda = blocks_.lambda;
     const auto damping = [this](Eigen::Index i) {
       return blocks_.damped() ? blocks_.damping[i] * z_(i, 1) : 0.0;
@@ -256,16 +257,16 @@ class ModalExponential : public Integrator {
         if (!(lambda[i] > 0.0)) continue;
         const double swing =
             (a_norm + std::abs(damping(i))) / lambda[i] + std::abs(z_(i, 1)) / std::sqrt(lambda[i]);
-        length_swing += reach_(i, 0) * swing;
-        angle_swing += reach_(i, 1) * swing;
+        length_swing += reach_.largest(i, 0) * swing;
+        angle_swing += reach_.largest(i, 1) * swing;
       }
       if (!(length_swing > kEdgeShare * length) && !(angle_swing > kEdgeShare * angle)) return 0.0;
       multiply_transposed(phi_, m0_v_.data(), edge_psi_a_.data());
     }
     const Eigen::ArrayXd swing =
         modal_swing(lambda, blocks_.damped() ? blocks_.damping : Eigen::ArrayXd(), z_, edge_psi_a_);
-    return std::max(modal_edge_rate(lambda, order_, swing, reach_.col(0), length, kEdgeShare),
-                    modal_edge_rate(lambda, order_, swing, reach_.col(1), angle, kEdgeShare));
+    return modal_elements_edge_rate(lambda, order_, swing, reach_, margins.length, margins.angle,
+                                    kEdgeShare);
   }
 
   // The frequency of the mechanism's ringing modes at the accepted state [rad/s] (0: none).
@@ -748,8 +749,8 @@ class ModalExponential : public Integrator {
       const ModeBlock& ringing = starting_ && bounds_.mechanism_wh > 0.0 ? start_ringing() : z_;
       // The modes that could carry an element across an edge of its range or of its warnings,
       // resolved (kResolvedPhase, kEdgeShare; data.pose is the accepted state's, just
-      // evaluated); a mechanism's steps resolve its ringing modes by their own bounds.
-      const double resolved_rate = bounds_.mechanism > 0.0 ? 0.0 : edge_rate();
+      // evaluated), a mechanism's too (its ringing modes also have their own bounds).
+      const double resolved_rate = edge_rate();
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
@@ -891,9 +892,9 @@ class ModalExponential : public Integrator {
   InitialLinearization initial_;  // why the initial state was linearized about (modal_reference)
   Eigen::Index band_needed_ = 0;  // the modes the chosen band needed
   Eigen::MatrixXd phi_;           // x = Phi z, z = Psi^T x with Psi = M0 Phi (project)
-  Eigen::ArrayX2d reach_;  // element_reach: each mode's largest change of an element's xi, angle
-  Eigen::VectorXd m0_v_;   // work space of project
-  ModeBlocks blocks_;      // the modes' linear part: eigenvalues and damping (exponential_step.hpp)
+  ElementReach reach_;            // how far each mode moves each element, in xi and angle
+  Eigen::VectorXd m0_v_;          // work space of project
+  ModeBlocks blocks_;  // the modes' linear part: eigenvalues and damping (exponential_step.hpp)
   double damping_coupling_ = 0.0;  // modal_damping: the damping left in N, per mode velocity
   ModalCoordinates coordinates_;   // the bodies' offsets from the linearization and back
   Block z_, x_;                    // the accepted state, modal and physical (x_ = Phi z_)

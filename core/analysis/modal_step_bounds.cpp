@@ -62,7 +62,7 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
   return 0.0;
 }
 
-Eigen::ArrayX2d element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi) {
+ElementReach element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi) {
   struct Lever {
     int row1, row2;  // the first of the bodies' 6 rows in phi; -1: fixed
     Vec3 arm1, arm2, span;
@@ -79,18 +79,26 @@ Eigen::ArrayX2d element_reach(const Model& model, const Data& data, const Eigen:
   };
   for (const Beam& e : model.beams) add(e.ends, rotation_measure(e));
   for (const Rail& e : model.rails) add(e.ends, rotation_measure(e));
-  Eigen::ArrayX2d reach = Eigen::ArrayX2d::Zero(phi.cols(), 2);
-  for (Eigen::Index i = 0; i < phi.cols(); ++i)
-    for (const Lever& l : levers) {
+  const Eigen::Index modes = phi.cols(), elements = static_cast<Eigen::Index>(levers.size());
+  ElementReach reach{Eigen::ArrayXXd::Zero(modes, elements), Eigen::ArrayXXd::Zero(modes, elements),
+                     Eigen::ArrayX2d::Zero(modes, 2)};
+  for (Eigen::Index e = 0; e < elements; ++e) {
+    const Lever& l = levers[e];
+    for (Eigen::Index i = 0; i < modes; ++i) {
       const auto part = [&](int row, int offset) {
         return row >= 0 ? Vec3(phi.col(i).segment<3>(row + offset)) : Vec3::Zero();
       };
       const Vec3 turn1 = part(l.row1, 3), turn2 = part(l.row2, 3);
       const Vec3 p1 = part(l.row1, 0) + turn1.cross(l.arm1);
       const Vec3 p2 = part(l.row2, 0) + turn2.cross(l.arm2);
-      reach(i, 0) = std::max(reach(i, 0), (p2 - p1 - turn1.cross(l.span)).norm());
-      reach(i, 1) = std::max(reach(i, 1), (turn2 - turn1).norm());
+      reach.length(i, e) = (p2 - p1 - turn1.cross(l.span)).norm();
+      reach.angle(i, e) = (turn2 - turn1).norm();
     }
+  }
+  if (elements > 0) {
+    reach.largest.col(0) = reach.length.rowwise().maxCoeff();
+    reach.largest.col(1) = reach.angle.rowwise().maxCoeff();
+  }
   return reach;
 }
 
@@ -106,8 +114,8 @@ Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& d
 }
 
 double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double margin,
-                       double share) {
+                       const Eigen::ArrayXd& swing, const Eigen::Ref<const Eigen::ArrayXd>& reach,
+                       double margin, double share) {
   double above = 0.0;
   for (Eigen::Index i : order) {
     if (!(lambda[i] > 0.0)) continue;
@@ -115,6 +123,26 @@ double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::In
     if (above > share * margin) return std::sqrt(lambda[i]);
   }
   return 0.0;
+}
+
+double modal_elements_edge_rate(const Eigen::ArrayXd& lambda,
+                                const std::vector<Eigen::Index>& order, const Eigen::ArrayXd& swing,
+                                const ElementReach& reach,
+                                const std::vector<double>& length_margins,
+                                const std::vector<double>& angle_margins, double share) {
+  const double length_swing = (reach.largest.col(0) * swing).sum();
+  const double angle_swing = (reach.largest.col(1) * swing).sum();
+  double rate = 0.0;
+  for (size_t e = 0; e < length_margins.size(); ++e) {
+    const auto col = static_cast<Eigen::Index>(e);
+    if (length_swing > share * length_margins[e])
+      rate = std::max(rate, modal_edge_rate(lambda, order, swing, reach.length.col(col),
+                                            length_margins[e], share));
+    if (angle_swing > share * angle_margins[e])
+      rate = std::max(rate, modal_edge_rate(lambda, order, swing, reach.angle.col(col),
+                                            angle_margins[e], share));
+  }
+  return rate;
 }
 
 ModeBlock ringing_about_static_state(const Eigen::ArrayXd& lambda, const ModeBlock& z,

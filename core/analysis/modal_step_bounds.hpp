@@ -149,22 +149,28 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // a swing, and an element held near an edge would have every step held.) Until 2026-12-02 the
 // steps resolved the fastest modes holding 1 % of the sum of the swings wherever the edges were:
 // the braced tower (docs/transient_measurements.md) then took 17,653 steps and 32.0 s for its 1 s
-// at rtol 1e-5 (1,884 steps and 5.4 s without). Not on a mechanism, whose ringing modes have
-// their own bound (ringing_rate) and whose motion is mostly in modes of lambda <= 0: a rigid
-// mode's path between two evaluations (a carriage thrown past its travel and back within a step)
-// is not bounded by this.
+// at rtol 1e-5 (1,884 steps and 5.4 s without). On mechanisms too (a first form left them to
+// their ringing bound, and a carriage free on its rail anywhere in a scene switched the bound off
+// for a spring-held one elsewhere, which left its travel unseen: an adversarial review); but a
+// rigid mode (lambda <= 0) has no swing, so its path between two evaluations (a carriage thrown
+// past its travel and back within a step) is not bounded by this.
 inline constexpr double kResolvedPhase = 3.14159265358979323846 / 8.0;
 inline constexpr double kEdgeShare = 0.5;
 
-// How far each mode moves the elements per unit of its coordinate (modes x 2): column 0 the
-// largest first-order change |d xi| of an element's point 2 in its left-end frame, xi = E1^T (p2 -
-// p1), column 1 the largest change |d theta_2 - d theta_1| of its relative rotation, over the beams
-// and rails: d xi = d p2 - d p1 - d theta_1 x (p2 - p1), d p_k = d c_k + d theta_k x R_k (R_k the
-// centre -> point k arm), from each body's offsets (d c, d theta) in `phi` (6 rows per free body,
+// How far each mode moves each element (the beams, then the rails) per unit of its coordinate:
+// `length` (modes x elements) the first-order change |d xi| of the element's point 2 in its
+// left-end frame, xi = E1^T (p2 - p1), `angle` the change |d theta_2 - d theta_1| of its relative
+// rotation, and `largest` (modes x 2) the largest of each over the elements: d xi = d p2 - d p1 -
+// d theta_1 x (p2 - p1), d p_k = d c_k + d theta_k x R_k (R_k the centre -> point k arm), from
+// each body's offsets (d c, d theta) in `phi` (6 rows per free body,
 // core/analysis/modal_coordinates.hpp; fixed bodies do not move) about the configuration of
 // data.pose. In a frame that turns with a floating part both ends turn with it: the lengths are
 // the same.
-Eigen::ArrayX2d element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi);
+struct ElementReach {
+  Eigen::ArrayXXd length, angle;
+  Eigen::ArrayX2d largest;
+};
+ElementReach element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi);
 
 // Each oscillating mode's amplitude about the static state of the forces at the state z (column
 // 0 displacements, 1 velocities): sqrt(((psi_a_i + c_i zdot_i) / lambda_i)^2 + zdot_i^2 /
@@ -177,8 +183,20 @@ Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& d
 // reach_i swing_i together pass `share` times `margin`; `order` the modes from the fastest down;
 // 0 when none do.
 double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::Index>& order,
-                       const Eigen::ArrayXd& swing, const Eigen::ArrayXd& reach, double margin,
-                       double share);
+                       const Eigen::ArrayXd& swing, const Eigen::Ref<const Eigen::ArrayXd>& reach,
+                       double margin, double share);
+
+// The largest modal_edge_rate over the elements, each with its own reach and margins
+// (element_margins in core/analysis/deformation_check.hpp): an element near its edge bounds the
+// steps only by the modes that move it (with the smallest margin against the largest reach, a
+// carriage standing 0.1 um from its travel's end held the steps of a scene to a steel link's
+// 8.4e4 rad/s ringing that cannot move it: 214,000 steps a second; an adversarial review). An
+// element is looked at only where the largest reach's swings could carry it across.
+double modal_elements_edge_rate(const Eigen::ArrayXd& lambda,
+                                const std::vector<Eigen::Index>& order, const Eigen::ArrayXd& swing,
+                                const ElementReach& reach,
+                                const std::vector<double>& length_margins,
+                                const std::vector<double>& angle_margins, double share);
 
 // z for the bounds of a step from a state where the forces may set modes ringing that do not
 // ring yet (a mechanism's first step, at the start or at a load's jump): each mode's

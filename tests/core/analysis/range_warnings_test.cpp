@@ -45,8 +45,8 @@ double number_after(const std::string& text, const std::string& key) {
 // The margins the modal method's steps resolve (core/analysis/modal_step_bounds.hpp), in
 // configurations set by hand: a disc twisted theta on a 1 m shaft is 0.5 - theta from the
 // small-angle warning, past it min(limit - theta, theta / 10); a carriage x from point 1 of a rail
-// without a travel, 0.01 m at the start, is 0.1 - x from its warning, past it x / 10; the shaft's
-// axial extent (1 m) is the other length margin.
+// without a travel, 0.01 m at the start, is 0.1 - x from its warning, past it x / 10, and x - 0.004
+// from its min_length while above it; the shaft's axial extent (1 m) is the other length margin.
 TEST(RangeWarnings, TheMarginsToTheEdgesAreTheirClosedForms) {
   Scene s;
   s.material("steel", kE, kG).circle("rod", 0.02);
@@ -55,21 +55,23 @@ TEST(RangeWarnings, TheMarginsToTheEdgesAreTheirClosedForms) {
   s.beam("shaft", "ground", "disc", Vec3::Zero(), Vec3(1, 0, 0), "steel", "rod");
   s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.01, 0, 0), "steel",
          "rod");
+  s.last_rail()["min_length"] = 0.004;
   const Model model = s.model();
   const double limit = angle_limit(rotation_measure(model.beams.at(0)));
   const int disc = testing::body_index(model, "disc");
   const int carriage = testing::body_index(model, "carriage");
   Data data(model);
   EXPECT_NEAR(element_angle_margin(model, data), kSmallAngleLimit, 1e-12);
-  EXPECT_NEAR(element_length_margin(model, data), 0.09, 1e-12);
+  EXPECT_NEAR(element_length_margin(model, data), 0.006, 1e-12);
   for (const double theta : {0.3, 0.7, 1.45}) {
     data.pose[disc].A = Eigen::AngleAxisd(theta, Vec3::UnitX()).toRotationMatrix();
     const double expected = theta < 0.5 ? 0.5 - theta : std::min(limit - theta, 0.1 * theta);
     EXPECT_NEAR(element_angle_margin(model, data), expected, 1e-9) << theta;
   }
-  for (const double x : {0.05, 0.2, 20.0}) {
+  for (const double x : {0.003, 0.05, 0.2, 20.0}) {
     data.pose[carriage].u = Vec3(x - 0.01, 0, 0);
-    const double expected = std::min(1.0, x < 0.1 ? 0.1 - x : 0.1 * x);
+    const double expected =
+        std::min({1.0, x < 0.1 ? 0.1 - x : 0.1 * x, x > 0.004 ? x - 0.004 : 1.0});
     EXPECT_NEAR(element_length_margin(model, data), expected, 1e-12) << x;
   }
 }

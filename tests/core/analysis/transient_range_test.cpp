@@ -382,5 +382,96 @@ TEST(TransientRange, AnElementsMotionIsItsEndsRelativeMotionNotABodys) {
   }
 }
 
+// Three more edges of a second adversarial review, closed forms:
+//  - a carriage (1 kg) on a rail without a travel, min_length 0.1 m, held by a 100 N/m spring,
+//    starting at 0.3 m at -v: x = 0.3 - (v / 10) sin(10 t). At v = 2.3 m/s it dips to 0.07 m
+//    every period and reached its min_length unseen (3 steps in 5 s, ok and silent); now it is
+//    warned of. At 1.5 m/s (down to 0.15 m) it is not.
+//  - the same carriage in a travel [0.1, 0.395] thrown at 1 m/s (x = 0.3 + 0.1 sin(10 t), out at
+//    asin(0.95) / 10 = 0.12532 s) beside a second carriage sliding free on its own rail: a
+//    mechanism anywhere switched the edge bounds off everywhere (4 steps in 0.6 s, ok).
+//  - a carriage standing still 0.1 um above its travel's end beside a swinging pair joined by a
+//    stiff steel link (8.4e4 rad/s, ringing 0.1 um): the smallest margin against the largest reach
+//    held the steps to the link's ringing, 42,824 steps in 0.2 s; the bound now takes each
+//    element's margin against the modes that move it.
+TEST(TransientRange, EdgesOfEveryKindAreResolvedByTheModesThatReachThem) {
+  const std::string materials = R"(
+    "materials": {"soft": {"E": 3e5, "G": 1.15e5}, "steel": {"E": 2.1e11, "G": 8.0769e10}},
+    "sections": {"rod": {"shape": "custom", "S": 1e-4, "Ix": 0.011, "Iy": 0.0055, "Iz": 0.0055},
+                 "rod20": {"shape": "circle", "diameter": 0.02}},)";
+  const auto carriage = [&](double v, const std::string& guide, const std::string& more_bodies,
+                            const std::string& more_rails) {
+    return "{" + materials + R"(
+      "bodies": [{"name": "A", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [0.3, 0, 0],
+                  "velocity": [)" +
+           std::to_string(v) + R"(, 0, 0]})" + more_bodies + R"(],
+      "beams": [{"name": "s1", "body1": "A", "body2": "ground", "point1": [0.3, 0, 0],
+                 "point2": [0.6, 0, 0], "point3": [0.3, 1, 0], "material": "soft",
+                 "section": "rod"}],
+      "rails": [{"name": "guide", "type": "prismatic", "body1": "ground", "body2": "A",
+                 "point1": [0, 0, 0], "point2": [0.3, 0, 0], "point3": [0, 1, 0],
+                 "material": "steel", "section": "rod20", )" +
+           guide + "}" + more_rails + "]}";
+  };
+  const auto run = [](const std::string& scene, const std::string& method, double t_end,
+                      double rtol) {
+    TransientOptions o = testing::range_options(method, t_end, t_end);
+    o.integrator.rtol = rtol;
+    o.integrator.atol = 1e-3 * rtol;
+    return simulate(testing::scene_from_json(scene), o);
+  };
+  for (const std::string method : {"auto", "modal"}) {
+    for (const double rtol : {1e-6, 1e-10}) {
+      for (const double v : {2.3, 1.5}) {
+        const auto r = run(carriage(-v, R"("min_length": 0.1)", "", ""), method, 5.0, rtol);
+        ASSERT_TRUE(r.result.ok) << method << ": " << r.result.message;
+        const bool warned = std::any_of(
+            r.result.warnings.begin(), r.result.warnings.end(), [](const std::string& w) {
+              return w.find("reached its min_length") != std::string::npos;
+            });
+        std::printf("min_length, %s, rtol %.0e, v %.1f: %ld steps, %s\n", method.c_str(), rtol, v,
+                    r.result.stats.steps, warned ? "warned" : "no warning");
+        EXPECT_EQ(warned, 0.3 - v / 10.0 < 0.1) << method << " v " << v;
+      }
+      const auto beside = run(carriage(1.0, R"("travel": [0.1, 0.395])", R"(,
+        {"name": "D", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [0.3, 3, 0],
+         "velocity": [0.1, 0, 0]})",
+                                       R"(,
+        {"name": "slide", "type": "prismatic", "body1": "ground", "body2": "D",
+         "point1": [0, 3, 0], "point2": [0.3, 3, 0], "point3": [0, 4, 0], "material": "steel",
+         "section": "rod20", "travel": [-10, 10]})"),
+                              method, 0.6, rtol);
+      std::printf("beside a mechanism, %s, rtol %.0e: %s at %.5f s, %ld steps\n", method.c_str(),
+                  rtol, beside.result.ok ? "ok" : "failed", beside.result.t_reached,
+                  beside.result.stats.steps);
+      EXPECT_FALSE(beside.result.ok) << method;
+      EXPECT_NE(beside.result.message.find("left the rail"), std::string::npos)
+          << beside.result.message;
+      EXPECT_NEAR(beside.result.t_reached, std::asin(0.95) / 10.0, 1e-3) << method;
+    }
+  }
+  const std::string still = "{" + materials + R"(
+    "bodies": [{"name": "A", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [0.3, 0, 0],
+                "velocity": [0.5, 0, 0]},
+               {"name": "B", "mass": 0.01, "inertia": [1e-5, 1e-5, 1e-5], "position": [0.6, 0, 0],
+                "velocity": [0.51, 0, 0]},
+               {"name": "C", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [0.3, 2, 0]}],
+    "beams": [{"name": "s1", "body1": "ground", "body2": "A", "point1": [0, 0, 0],
+               "point2": [0.3, 0, 0], "point3": [0, 1, 0], "material": "soft", "section": "rod"},
+              {"name": "c", "body1": "A", "body2": "B", "point1": [0.3, 0, 0],
+               "point2": [0.6, 0, 0], "point3": [0.3, 1, 0], "material": "steel",
+               "section": "rod"},
+              {"name": "sC", "body1": "ground", "body2": "C", "point1": [0, 2, 0],
+               "point2": [0.3, 2, 0], "point3": [0, 3, 0], "material": "soft", "section": "rod"}],
+    "rails": [{"name": "guideC", "type": "prismatic", "body1": "ground", "body2": "C",
+               "point1": [0, 2, 0], "point2": [0.3, 2, 0], "point3": [0, 3, 0],
+               "material": "steel", "section": "rod20", "travel": [0.2999999, 0.6]}]})";
+  const auto r = run(still, "modal", 0.2, 1e-6);
+  std::printf("a still carriage at its edge beside a ringing link: %s, %ld steps\n",
+              r.result.ok ? "ok" : r.result.message.c_str(), r.result.stats.steps);
+  EXPECT_TRUE(r.result.ok) << r.result.message;
+  EXPECT_LT(r.result.stats.steps, 100);
+}
+
 }  // namespace
 }  // namespace beamrail

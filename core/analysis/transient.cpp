@@ -335,6 +335,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
           result.timed_out = context.timed_out;
           result.interrupted = context.interrupted;
           result.message = context.interrupted ? "interrupted" : integrator->failure(flag);
+          result.out_of_range = !context.out_of_range.empty() &&
+                                result.message.find(context.out_of_range) != std::string::npos;
           if (harmonic_held && result.message.find("max_steps") != std::string::npos) {
             char why[160];
             std::snprintf(why, sizeof why,
@@ -351,6 +353,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
       // An element outside the range of its law ends the run (checked at accepted states).
       if (std::string range = element_out_of_range(model, data); result.ok && !range.empty()) {
         result.ok = false;
+        result.out_of_range = true;
         char when[64];
         std::snprintf(when, sizeof when, "at t = %.6g s, ", t_out);
         result.message = when + range;

@@ -136,6 +136,7 @@ struct TransientResult {
   bool ok = false;
   bool timed_out = false;      // stopped by max_seconds
   bool interrupted = false;    // stopped by a stop request (stop_request.hpp)
+  bool out_of_range = false;   // stopped where an element left its law's range (message: which)
   std::string linear_solver;   // dense | sparse | none
   long jacobian_nonzeros = 0;  // stored entries of the sparse Jacobian
   std::string message;         // why it stopped early, when !ok

@@ -618,6 +618,7 @@ class Runner {
       seconds += r.result.stats.wall_seconds;
       v.ok = r.result.ok;
       v.message = r.result.message;
+      v.out_of_range = r.result.out_of_range;
       v.stats = r.result.stats;
       v.stats.wall_seconds = seconds;  // of the reruns together
       v.error = r.result.ok ? trajectory_error(run, r.samples) : kNaN;

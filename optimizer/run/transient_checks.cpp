@@ -194,6 +194,14 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
     // designs fit max_seconds_per_design but whose reruns do not warned on every row; an
     // adversarial review of bdf's verification, 2026-11-30).
     const bool unasked = spec.verify == AnalysisSpec::Verify::kAuto;
+    // A tighter run that saw an element leave its law's range, where the run went through: the
+    // run stepped over it, and its results past there are not the model's (no budget helps).
+    if (v.out_of_range)
+      return "transient \"" + spec.name + "\": " + rerun +
+             " failed where an element left the range of its law (" + v.message +
+             "), which the run stepped over: its results from there on cannot be trusted; run it "
+             "at rtol " +
+             two_digits(v.rtol) + " or with a shorter max_step";
     return "transient \"" + spec.name + "\": " + rerun + " failed (" + v.message +
            "): the run's error is not measured" +
            (unasked ? "; give it more max_seconds or max_steps, or \"verify\": false skips it"

@@ -19,6 +19,7 @@ namespace beamrail {
 struct Verification {
   bool ok = false;
   std::string message;
+  bool out_of_range = false;      // the tighter run stopped where an element left its range
   double rtol = 0.0, atol = 0.0;  // of the tighter run
   double fixed_step = 0.0;        // of the tighter run (half the run's); 0: adaptive
   // Where the first rerun repeated the run state for state: the second rerun's longest step

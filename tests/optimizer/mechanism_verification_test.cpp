@@ -212,6 +212,49 @@ TEST_F(MechanismVerification, ARerunThatFailsWarnsThatNothingWasMeasured) {
   EXPECT_TRUE(skippable) << summary.dump(2);
 }
 
+// A rerun that stops where an element leaves its law's range, where the run went through, says
+// that the run stepped over it and cannot be trusted from there (it said to give the rerun more
+// max_seconds or max_steps, which measures nothing more; a second adversarial review,
+// 2026-12-02). A carriage on a 100 N/m spring thrown at 1 m/s swings x = 0.3 + 0.1 sin(10 t),
+// 0.1 mm past its travel's end at 0.3999 m; bdf at rtol 1e-3 (verified by default) steps over
+// both peaks, its rerun at 1e-4 sees the second.
+TEST_F(MechanismVerification, ARerunThatSeesAnElementLeaveItsRangeSaysTheRunCannotBeTrusted) {
+  const Json s = Json::parse(R"({"name": "carriage",
+    "scene": {
+      "materials": {"soft": {"E": 3e5, "G": 1.15e5}, "steel": {"E": 2.1e11, "G": 8.0769e10}},
+      "sections": {"rod": {"shape": "custom", "S": 1e-4, "Ix": 0.011, "Iy": 0.0055, "Iz": 0.0055},
+                   "rod20": {"shape": "circle", "diameter": 0.02}},
+      "bodies": [{"name": "A", "mass": 1, "inertia": [1e-3, 1e-3, 1e-3], "position": [0.3, 0, 0],
+                  "velocity": [1, 0, 0]}],
+      "beams": [{"name": "s1", "body1": "A", "body2": "ground", "point1": [0.3, 0, 0],
+                 "point2": [0.6, 0, 0], "point3": [0.3, 1, 0], "material": "soft",
+                 "section": "rod"}],
+      "rails": [{"name": "guide", "type": "prismatic", "body1": "ground", "body2": "A",
+                 "point1": [0, 0, 0], "point2": [0.3, 0, 0], "point3": [0, 1, 0],
+                 "material": "steel", "section": "rod20", "travel": [0.1, 0.3999]}]},
+    "analyses": [{"type": "transient", "t_end": 1.0, "output_step": 0.5,
+                  "integrator": {"method": "bdf", "rtol": 1e-3, "atol": 1e-6}}]})");
+  run_ok(write_study("carriage.json", s), "carriage");
+  const Json summary = load_json(dir_ / "carriage/summary.json");
+  const Json& a = summary["analyses"][0];
+  std::printf("run: %s, %ld steps; rerun: %s\n", summary["status"].dump().c_str(),
+              a["steps"].get<long>(), a["verification"].dump().c_str());
+  EXPECT_EQ(summary["status"], "ok");
+  ASSERT_TRUE(a.contains("verification")) << a.dump(2);
+  EXPECT_EQ(a["verification"]["status"], "failed");
+  EXPECT_NE(a["verification"]["message"].get<std::string>().find("left the rail"),
+            std::string::npos);
+  bool untrusted = false, budget = false;
+  for (const Json& w : summary["warnings"]) {
+    const std::string text = w.get<std::string>();
+    untrusted = untrusted || (text.find("left the range of its law") != std::string::npos &&
+                              text.find("cannot be trusted") != std::string::npos);
+    budget = budget || text.find("more max_seconds") != std::string::npos;
+  }
+  EXPECT_TRUE(untrusted) << summary.dump(2);
+  EXPECT_FALSE(budget) << summary.dump(2);
+}
+
 // A rotor spinning freely at 5 rad/s on a revolute joint turns 10 rad in 2 s; its centre stays,
 // so only its orientation can be off. Its phase error grows with the angle turned, and the
 // verification weighs it against that angle (rtol x 10 rad + atol), not against the largest

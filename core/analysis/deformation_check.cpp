@@ -112,18 +112,6 @@ ElementMargins element_margins(const Model& model, const Data& data) {
   return out;
 }
 
-double element_length_margin(const Model& model, const Data& data) {
-  const std::vector<double> m = element_margins(model, data).length;
-  return m.empty() ? std::numeric_limits<double>::infinity()
-                   : *std::min_element(m.begin(), m.end());
-}
-
-double element_angle_margin(const Model& model, const Data& data) {
-  const std::vector<double> m = element_margins(model, data).angle;
-  return m.empty() ? std::numeric_limits<double>::infinity()
-                   : *std::min_element(m.begin(), m.end());
-}
-
 std::string element_turned_beyond(const Model& model, const Data& data, double limit) {
   const auto rotation = [](const ElementFrames<double>& f, bool twist_free) {
     if (twist_free) return std::atan2(Vec3(f.a.col(0)).tail<2>().norm(), f.a(0, 0));

@@ -26,8 +26,8 @@ namespace beamrail {
 
 inline constexpr double kSmallAngleLimit = 0.5;     // [rad]
 inline constexpr double kRailTravelWarning = 10.0;  // times the initial distance
-// Past a warning's edge, the part of an element's angle (distance) that element_angle_margin
-// (element_length_margin) gives as its margin: the modal method's steps resolve the swings of
+// Past a warning's edge, the part of an element's angle (distance) that element_margins
+// gives as its margin (an angle, a distance): the modal method's steps resolve the swings of
 // that size, so that the peak the warning reports is the motion's, not a step's
 // (core/analysis/modal_step_bounds.hpp).
 inline constexpr double kWarnedMargin = 0.1;
@@ -50,10 +50,6 @@ struct ElementMargins {
   std::vector<double> length, angle;
 };
 ElementMargins element_margins(const Model& model, const Data& data);
-
-// The smallest of element_margins' lengths, of its angles; infinity without elements.
-double element_length_margin(const Model& model, const Data& data);
-double element_angle_margin(const Model& model, const Data& data);
 
 // The first element whose relative rotation (the angle of E1^T E2 in [0, pi]; for a cylindrical
 // rail, the angle between the rail's axis and the carriage's) exceeds `limit` [rad], described for

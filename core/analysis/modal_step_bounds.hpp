@@ -134,8 +134,8 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // could carry an element across the nearest of those edges: no longer than kResolvedPhase / w,
 // w the frequency of the slowest of the fastest oscillating modes whose swings together reach
 // kEdgeShare of the element's margin to it (modal_edge_rate). The margins: in length
-// (element_length_margin: a beam's axial extent, a carriage's distance to its travel's ends or
-// to its travel warning), in angle (element_angle_margin: to the small-angle warning, past it to
+// (element_margins: a beam's axial extent, a carriage's distance to its travel's ends or
+// to its travel warning), in angle (element_margins: to the small-angle warning, past it to
 // the limit of the element's measure). A mode's swing is its amplitude about the static state of
 // the forces at the step's start (modal_swing) times the largest change it makes in an element's
 // point 2 relative to its left end, or in its relative rotation (element_reach): counted as the

@@ -61,6 +61,15 @@ TEST(RangeWarnings, TheMarginsToTheEdgesAreTheirClosedForms) {
   const int disc = testing::body_index(model, "disc");
   const int carriage = testing::body_index(model, "carriage");
   Data data(model);
+  // The smallest margin over the elements, in length and in angle.
+  const auto element_length_margin = [](const Model& m, const Data& d) {
+    const std::vector<double> v = element_margins(m, d).length;
+    return *std::min_element(v.begin(), v.end());
+  };
+  const auto element_angle_margin = [](const Model& m, const Data& d) {
+    const std::vector<double> v = element_margins(m, d).angle;
+    return *std::min_element(v.begin(), v.end());
+  };
   EXPECT_NEAR(element_angle_margin(model, data), kSmallAngleLimit, 1e-12);
   EXPECT_NEAR(element_length_margin(model, data), 0.006, 1e-12);
   for (const double theta : {0.3, 0.7, 1.45}) {

@@ -231,15 +231,16 @@ class ModalExponential : public Integrator {
     return start_ringing_;
   }
 
-  // The frequency [rad/s] of the modes a step from the accepted state must resolve so that no
-  // element crosses an edge of its range or of its warnings unseen (modal_edge_rate); 0: none.
-  // Either N at that state is in n0_, or (every mode integrated) M0 a is in m0_v_ and a in
-  // acceleration_: there the modal accelerations cost a pass over Phi, taken only when a bound on
-  // the swings (|psi_a_i| <= |a|_M0, the modes mass-normalized) does not already rule the edges
-  // out (the braced tower: never).
-  double edge_rate() {
+  // The longest step, at most `h`, from the accepted state that no element crosses an edge of
+  // its range or of its warnings unseen: the modes that could carry it there resolved
+  // (kResolvedPhase / modal_edge_rate), the paths of the slow and rigid modes bounded
+  // (modal_slow_edge_step). Either N at that state is in n0_, or (every mode integrated) M0 a is
+  // in m0_v_ and a in acceleration_: there the modal accelerations cost a pass over Phi, taken
+  // only when a bound on them (|psi_a_i| <= |a|_M0, the modes mass-normalized) does not already
+  // rule the edges out (the braced tower: never).
+  double edge_step(double h) {
     const ElementMargins margins = element_margins(context_->model, context_->data);
-    if (margins.length.empty()) return 0.0;
+    if (margins.length.empty()) return h;
     const double length = *std::min_element(margins.length.begin(), margins.length.end());
     const double angle = *std::min_element(margins.angle.begin(), margins.angle.end());
     const Eigen::ArrayXd& lambda = blocks_.lambda;
@@ -252,21 +253,32 @@ class ModalExponential : public Integrator {
         edge_psi_a_[i] = n0_(i, 1) - lambda[i] * z_(i, 0) - damping(i);
     } else {
       const double a_norm = std::sqrt(std::max(acceleration_.dot(m0_v_), 0.0));
-      double length_swing = 0.0, angle_swing = 0.0;
+      double length_swing = 0.0, angle_swing = 0.0, length_drift = 0.0, angle_drift = 0.0;
       for (Eigen::Index i = 0; i < m_; ++i) {
+        if (!(lambda[i] * h * h > kResolvedPhase * kResolvedPhase)) {
+          length_drift += reach_.largest(i, 0) * a_norm;
+          angle_drift += reach_.largest(i, 1) * a_norm;
+        }
         if (!(lambda[i] > 0.0)) continue;
         const double swing =
             (a_norm + std::abs(damping(i))) / lambda[i] + std::abs(z_(i, 1)) / std::sqrt(lambda[i]);
         length_swing += reach_.largest(i, 0) * swing;
         angle_swing += reach_.largest(i, 1) * swing;
       }
-      if (!(length_swing > kEdgeShare * length) && !(angle_swing > kEdgeShare * angle)) return 0.0;
+      const double passed = h * h / 8.0;  // a parabola's excursion per unit acceleration
+      if (!(length_swing > kEdgeShare * length) && !(angle_swing > kEdgeShare * angle) &&
+          !(length_drift * passed > kSlowEdgeShare * length) &&
+          !(angle_drift * passed > kSlowEdgeShare * angle))
+        return h;
       multiply_transposed(phi_, m0_v_.data(), edge_psi_a_.data());
     }
     const Eigen::ArrayXd swing =
         modal_swing(lambda, blocks_.damped() ? blocks_.damping : Eigen::ArrayXd(), z_, edge_psi_a_);
-    return modal_elements_edge_rate(lambda, order_, swing, reach_, margins.length, margins.angle,
-                                    kEdgeShare);
+    const double rate = modal_elements_edge_rate(lambda, order_, swing, reach_, margins.length,
+                                                 margins.angle, kEdgeShare);
+    if (rate > 0.0) h = std::min(h, kResolvedPhase / rate);
+    return modal_slow_edge_step(lambda, edge_psi_a_, reach_, margins.length, margins.angle, h,
+                                kSlowEdgeShare);
   }
 
   // The frequency of the mechanism's ringing modes at the accepted state [rad/s] (0: none).
@@ -747,16 +759,19 @@ class ModalExponential : public Integrator {
       // A mechanism's first step (from the run's start, a load's jump or auto's relinearization):
       // the modes as they will ring about the static state of the forces there.
       const ModeBlock& ringing = starting_ && bounds_.mechanism_wh > 0.0 ? start_ringing() : z_;
-      // The modes that could carry an element across an edge of its range or of its warnings,
-      // resolved (kResolvedPhase, kEdgeShare; data.pose is the accepted state's, just
-      // evaluated), a mechanism's too (its ringing modes also have their own bounds).
-      const double resolved_rate = edge_rate();
+      // No element carried across an edge of its range or of its warnings unseen (edge_step:
+      // the modes that could reach it resolved, the rigid and slow modes' paths bounded;
+      // data.pose is the accepted state's, just evaluated), a mechanism's too (its ringing modes
+      // also have their own bounds).
+      double longest = std::min(h_, target - t_);
+      if (options_.max_step > 0.0) longest = std::min(longest, options_.max_step);
+      const double edge_h = edge_step(longest);
       for (int attempt = 0;; ++attempt) {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
         const bool mechanism_holds = mechanism_bound(ringing);
         h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate(ringing));
-        if (resolved_rate > 0.0) h = std::min(h, kResolvedPhase / resolved_rate);
+        h = std::min(h, edge_h);
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
         if (!(h > 1e-14 * std::max(1.0, std::abs(t_))))
@@ -882,7 +897,7 @@ class ModalExponential : public Integrator {
   QuasiStaticModes quasi_;
   Eigen::SparseMatrix<double> m0_;
   Eigen::VectorXd m0_a_, psi_a_;  // work space: M0 a, Phi^T M0 a
-  Eigen::ArrayXd edge_psi_a_;     // work space of edge_rate: Phi^T M0 a at the accepted state
+  Eigen::ArrayXd edge_psi_a_;     // work space of edge_step: Phi^T M0 a at the accepted state
   Block n0_;                      // N at the accepted state, when have_n0_
   bool have_n0_ = false;
   bool starting_ = true;          // no step accepted since the start or the last restart

@@ -66,19 +66,22 @@ ElementReach element_reach(const Model& model, const Data& data, const Eigen::Ma
   struct Lever {
     int row1, row2;  // the first of the bodies' 6 rows in phi; -1: fixed
     Vec3 arm1, arm2, span;
+    Vec3 free_axis;  // a cylindrical rail's axis, about which it turns freely; else zero
   };
   std::vector<Lever> levers;
-  const auto add = [&](const ElementEnds& ends, RotationMeasure measure) {
+  const auto add = [&](const ElementEnds& ends, RotationMeasure measure, bool twist_free) {
     const ElementFrames<double> f =
         element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], measure);
     const auto row = [&model](int body) {
       const int free = model.bodies[body].free_index;
       return free >= 0 ? kDofsPerBody * free : -1;
     };
-    levers.push_back({row(ends.body1), row(ends.body2), f.R1, f.R2, f.lever1 - f.R1});
+    levers.push_back({row(ends.body1), row(ends.body2), f.R1, f.R2, f.lever1 - f.R1,
+                      twist_free ? Vec3(f.E1.col(0)) : Vec3::Zero()});
   };
-  for (const Beam& e : model.beams) add(e.ends, rotation_measure(e));
-  for (const Rail& e : model.rails) add(e.ends, rotation_measure(e));
+  for (const Beam& e : model.beams) add(e.ends, rotation_measure(e), false);
+  for (const Rail& e : model.rails)
+    add(e.ends, rotation_measure(e), e.type == RailType::kCylindrical);
   const Eigen::Index modes = phi.cols(), elements = static_cast<Eigen::Index>(levers.size());
   ElementReach reach{Eigen::ArrayXXd::Zero(modes, elements), Eigen::ArrayXXd::Zero(modes, elements),
                      Eigen::ArrayX2d::Zero(modes, 2)};
@@ -92,7 +95,8 @@ ElementReach element_reach(const Model& model, const Data& data, const Eigen::Ma
       const Vec3 p1 = part(l.row1, 0) + turn1.cross(l.arm1);
       const Vec3 p2 = part(l.row2, 0) + turn2.cross(l.arm2);
       reach.length(i, e) = (p2 - p1 - turn1.cross(l.span)).norm();
-      reach.angle(i, e) = (turn2 - turn1).norm();
+      const Vec3 turn = turn2 - turn1;
+      reach.angle(i, e) = (turn - turn.dot(l.free_axis) * l.free_axis).norm();
     }
   }
   if (elements > 0) {
@@ -143,6 +147,31 @@ double modal_elements_edge_rate(const Eigen::ArrayXd& lambda,
                                             angle_margins[e], share));
   }
   return rate;
+}
+
+double modal_slow_edge_step(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& accel,
+                            const ElementReach& reach, const std::vector<double>& length_margins,
+                            const std::vector<double>& angle_margins, double h, double share) {
+  const double slow = kResolvedPhase * kResolvedPhase;
+  Eigen::ArrayXd a = Eigen::ArrayXd::Zero(lambda.size());
+  bool any = false;
+  for (Eigen::Index i = 0; i < lambda.size(); ++i)
+    if (!(lambda[i] * h * h > slow)) {
+      a[i] = std::abs(accel[i]);
+      any = any || a[i] > 0.0;
+    }
+  if (!any) return h;
+  const auto limit = [&](const Eigen::Ref<const Eigen::ArrayXd>& reach_e, double margin) {
+    const double drift = (reach_e * a).sum();  // sum_i reach_i |a_i|
+    if (margin > 0.0 && drift * h * h / 8.0 > share * margin)
+      h = std::sqrt(8.0 * share * margin / drift);
+  };
+  for (size_t e = 0; e < length_margins.size(); ++e) {
+    const auto col = static_cast<Eigen::Index>(e);
+    limit(reach.length.col(col), length_margins[e]);
+    limit(reach.angle.col(col), angle_margins[e]);
+  }
+  return h;
 }
 
 ModeBlock ringing_about_static_state(const Eigen::ArrayXd& lambda, const ModeBlock& z,

@@ -153,16 +153,26 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
 // their ringing bound, and a carriage free on its rail anywhere in a scene switched the bound off
 // for a spring-held one elsewhere, which left its travel unseen: an adversarial review); but a
 // rigid mode (lambda <= 0) has no swing, so its path between two evaluations (a carriage thrown
-// past its travel and back within a step) is not bounded by this.
+// past its travel and back within a step) is not bounded by this: modal_slow_edge_step is.
 inline constexpr double kResolvedPhase = 3.14159265358979323846 / 8.0;
 inline constexpr double kEdgeShare = 0.5;
+// A rigid mode (lambda <= 0) has no swing, and a slow one swings about a static state far away:
+// over a step both move along near parabolas, and a path that leaves an element's range and
+// comes back between two evaluations is not seen (a carriage thrown up a rail against a constant
+// force, past its travel's end and back within one step of 0.5 s, ok; found 2026-12-02). Between
+// two accepted states h apart (where the warnings are watched; the stages are h / 2 apart) a
+// path of acceleration a passes the larger of its two ends by at most |a| h^2 / 8. So a step
+// stays below sqrt(8 kSlowEdgeShare m / sum_i reach_i |a_i|) for each element of margin m, over
+// the modes the step resolves anyway (lambda_i h^2 <= kResolvedPhase^2; modal_slow_edge_step).
+inline constexpr double kSlowEdgeShare = 0.25;
 
 // How far each mode moves each element (the beams, then the rails) per unit of its coordinate:
 // `length` (modes x elements) the first-order change |d xi| of the element's point 2 in its
 // left-end frame, xi = E1^T (p2 - p1), `angle` the change |d theta_2 - d theta_1| of its relative
-// rotation, and `largest` (modes x 2) the largest of each over the elements: d xi = d p2 - d p1 -
-// d theta_1 x (p2 - p1), d p_k = d c_k + d theta_k x R_k (R_k the centre -> point k arm), from
-// each body's offsets (d c, d theta) in `phi` (6 rows per free body,
+// rotation (of a cylindrical rail without the part about its axis, where it turns freely: its
+// angle measure does not see it), and `largest` (modes x 2) the largest of each over the elements:
+// d xi = d p2 - d p1 - d theta_1 x (p2 - p1), d p_k = d c_k + d theta_k x R_k (R_k the centre ->
+// point k arm), from each body's offsets (d c, d theta) in `phi` (6 rows per free body,
 // core/analysis/modal_coordinates.hpp; fixed bodies do not move) about the configuration of
 // data.pose. In a frame that turns with a floating part both ends turn with it: the lengths are
 // the same.
@@ -192,6 +202,14 @@ double modal_edge_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen::In
 // carriage standing 0.1 um from its travel's end held the steps of a scene to a steel link's
 // 8.4e4 rad/s ringing that cannot move it: 214,000 steps a second; an adversarial review). An
 // element is looked at only where the largest reach's swings could carry it across.
+// The longest step [s], at most `h`, over which the modes slower than h resolves (lambda_i h^2 <=
+// kResolvedPhase^2, every rigid mode) cannot carry an element across `share` of its margin
+// unseen: sqrt(8 share m_e / sum_i reach_ie |accel_i|) over the elements e (margins m_e, reach
+// as in modal_elements_edge_rate); `accel` the modes' accelerations at the accepted state.
+double modal_slow_edge_step(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& accel,
+                            const ElementReach& reach, const std::vector<double>& length_margins,
+                            const std::vector<double>& angle_margins, double h, double share);
+
 double modal_elements_edge_rate(const Eigen::ArrayXd& lambda,
                                 const std::vector<Eigen::Index>& order, const Eigen::ArrayXd& swing,
                                 const ElementReach& reach,

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/analysis/deformation_check.hpp"
+#include "core/analysis/modal_step_bounds.hpp"
 #include "core/analysis/transient.hpp"
 #include "core/model/data.hpp"
 #include "core/model/element_kinematics.hpp"
@@ -163,6 +164,55 @@ TEST(RangeWarnings, ACarriageFarOutOnARailWithoutATravelBetweenRowsIsWarnedOf) {
     EXPECT_LE(ratio, 21.05) << method;
     EXPECT_GE(ratio, 1.0 + 10.0 * (1.0 + std::cos(kPi / 8))) << method;
     EXPECT_NEAR(ratio, 1.0 + 10.0 * (1.0 - std::cos(12.0 * when)), 0.05) << method;
+  }
+}
+
+// How far a mode moves an element (element_reach), by hand: a 1 kg bob 0.5 m below its rail's
+// point 2 (on the rail's axis, x), the rail from the ground's origin to (0.3, 0, 0). A unit turn
+// about the axis (the centre moving (0, 0.5, 0) with it) leaves point 2 where it is and turns the
+// element 1 rad, which a cylindrical rail's angle measure does not see (it turns freely there):
+// 0 for it, 1 for a prismatic one. A unit turn about z about the bob's centre moves point 2 by
+// (0, 0, 1) x (0, 0, 0.5) = 0: length 0, angle 1 for both. A unit slide along x moves it 1, no
+// angle. And the longest step over which those paths cannot carry the element across a quarter
+// of its margin m unseen (modal_slow_edge_step): sqrt(8 m / 4 / sum reach |a|).
+TEST(RangeWarnings, AModeMovesAnElementByItsEndsRelativeMotion) {
+  for (const std::string type : {"cylindrical", "prismatic"}) {
+    Scene s;
+    s.material("steel", kE, kG).circle("rod", 0.02);
+    s.body("bob", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.3, 0, -0.5));
+    s.rail("hinge", type, "ground", "bob", Vec3::Zero(), Vec3(0.3, 0, 0), "steel", "rod");
+    const Model model = s.model();
+    const Data data(model);
+    Eigen::MatrixXd phi = Eigen::MatrixXd::Zero(6, 3);
+    phi.col(0) << 0, 0.5, 0, 1, 0, 0;  // a turn about the rail's axis
+    phi.col(1) << 0, 0, 0, 0, 0, 1;    // a turn about z about the centre
+    phi.col(2) << 1, 0, 0, 0, 0, 0;    // a slide along the rail
+    const ElementReach reach = element_reach(model, data, phi);
+    ASSERT_EQ(reach.length.rows(), 3);
+    ASSERT_EQ(reach.length.cols(), 1);
+    const double about_axis = type == "cylindrical" ? 0.0 : 1.0;
+    EXPECT_NEAR(reach.length(0, 0), 0.0, 1e-12) << type;
+    EXPECT_NEAR(reach.angle(0, 0), about_axis, 1e-12) << type;
+    EXPECT_NEAR(reach.length(1, 0), 0.0, 1e-12) << type;
+    EXPECT_NEAR(reach.angle(1, 0), 1.0, 1e-12) << type;
+    EXPECT_NEAR(reach.length(2, 0), 1.0, 1e-12) << type;
+    EXPECT_NEAR(reach.angle(2, 0), 0.0, 1e-12) << type;
+    EXPECT_NEAR(reach.largest(1, 1), 1.0, 1e-12) << type;
+    // Three rigid modes accelerating at 2, 3 and 5 (units per s^2), margins 1 m and 0.4 rad:
+    // length sum 5 (the slide), angle sum 2 about_axis + 3, which decides.
+    const Eigen::ArrayXd lambda = Eigen::ArrayXd::Zero(3);
+    const Eigen::ArrayXd accel = (Eigen::ArrayXd(3) << 2.0, -3.0, 5.0).finished();
+    const double h = modal_slow_edge_step(lambda, accel, reach, {1.0}, {0.4}, 10.0, 0.25);
+    const double expected = std::min(std::sqrt(8.0 * 0.25 * 1.0 / 5.0),
+                                     std::sqrt(8.0 * 0.25 * 0.4 / (2.0 * about_axis + 3.0)));
+    EXPECT_NEAR(h, expected, 1e-12) << type;
+    // A step already that short is left as it is; an oscillating mode the step does not resolve
+    // (lambda h^2 above (pi / 8)^2) is not counted: only the slide's 5 remains in length.
+    EXPECT_EQ(modal_slow_edge_step(lambda, accel, reach, {0.1}, {0.4}, 0.01, 0.25), 0.01);
+    const Eigen::ArrayXd turning = (Eigen::ArrayXd(3) << 1e4, 1e4, 0.0).finished();
+    EXPECT_NEAR(modal_slow_edge_step(turning, accel, reach, {0.1}, {0.4}, 1.0, 0.25),
+                std::sqrt(8.0 * 0.25 * 0.1 / 5.0), 1e-12)
+        << type;
   }
 }
 

@@ -1,6 +1,7 @@
 #include "optimizer/run/transient_checks.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <limits>
 
@@ -169,6 +170,33 @@ void weigh_verification(const TransientOptions& options, Verification* v) {
         v->rotation_error * v->turn / (rtol * std::max(v->turned, 1.0) + atol);  // [rad] / [rad]
 }
 
+namespace {
+
+// What was rerun: the run, or the refined run that replaced it.
+std::string rerun_description(const std::optional<Refinement>& refinement) {
+  if (!refinement) return "the verification rerun";
+  const Verification& first = refinement->first_run;
+  return "its verification rerun found the run " +
+         two_digits(std::max(first.tolerances >= 0.0 ? first.tolerances : 0.0,
+                             first.rotation_tolerances >= 0.0 ? first.rotation_tolerances : 0.0)) +
+         " times its tolerance off, so it was run again at rtol " + two_digits(first.rtol) +
+         " (\"refine\"), and that run's verification rerun";
+}
+
+}  // namespace
+
+std::string verification_out_of_range(const Verification& v,
+                                      const std::optional<Refinement>& refinement) {
+  if (v.ok || !v.out_of_range) return "";
+  std::string rerun = rerun_description(refinement);
+  rerun[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(rerun[0])));
+  return rerun + " at rtol " + two_digits(v.rtol) +
+         " failed where an element left the range of its law (" + v.message +
+         "), which the run stepped over: its results from there on are not the model's; a run at "
+         "rtol " +
+         two_digits(v.rtol) + " or with a shorter max_step stops there";
+}
+
 // The warning of a verification rerun farther from the run than kDriftTolerance times its
 // tolerance (weigh_verification; "" when it is within it, or for a fixed step; a rerun that
 // failed warns that it measured nothing).
@@ -176,17 +204,7 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
                                  const Verification& v,
                                  const std::optional<Refinement>& refinement) {
   const double rtol = options.integrator.rtol;
-  // What was rerun: the run, or the refined run that replaced it.
-  std::string rerun = "the verification rerun";
-  if (refinement) {
-    const Verification& first = refinement->first_run;
-    rerun =
-        "its verification rerun found the run " +
-        two_digits(std::max(first.tolerances >= 0.0 ? first.tolerances : 0.0,
-                            first.rotation_tolerances >= 0.0 ? first.rotation_tolerances : 0.0)) +
-        " times its tolerance off, so it was run again at rtol " + two_digits(first.rtol) +
-        " (\"refine\"), and that run's verification rerun";
-  }
+  const std::string rerun = rerun_description(refinement);
   if (!v.ok) {
     // A rerun that did not finish measured nothing (the run at rtol 1e-8 of a carriage with a
     // pendulum under a harmonic force: its rerun spent max_steps in 50 s, the run took 10 s).
@@ -194,14 +212,6 @@ std::string verification_warning(const AnalysisSpec& spec, const TransientOption
     // designs fit max_seconds_per_design but whose reruns do not warned on every row; an
     // adversarial review of bdf's verification, 2026-11-30).
     const bool unasked = spec.verify == AnalysisSpec::Verify::kAuto;
-    // A tighter run that saw an element leave its law's range, where the run went through: the
-    // run stepped over it, and its results past there are not the model's (no budget helps).
-    if (v.out_of_range)
-      return "transient \"" + spec.name + "\": " + rerun +
-             " failed where an element left the range of its law (" + v.message +
-             "), which the run stepped over: its results from there on cannot be trusted; run it "
-             "at rtol " +
-             two_digits(v.rtol) + " or with a shorter max_step";
     return "transient \"" + spec.name + "\": " + rerun + " failed (" + v.message +
            "): the run's error is not measured" +
            (unasked ? "; give it more max_seconds or max_steps, or \"verify\": false skips it"

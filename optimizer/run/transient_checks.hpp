@@ -89,6 +89,13 @@ std::string verified_after_the_run(const AnalysisSpec& spec, const Model& model,
 // Sets v's distances in multiples of the tolerance of the run (options): the warning's measure.
 void weigh_verification(const TransientOptions& options, Verification* v);
 
+// The failure of a run whose verification rerun stopped where an element left its law's range
+// (v.out_of_range), where the run went through: the run stepped over it, and its results from
+// there on are not the model's, which `ok` would promise (README "Guarantees"); no budget helps.
+// "" for any other rerun. The analysis's failure names the analysis.
+std::string verification_out_of_range(const Verification& v,
+                                      const std::optional<Refinement>& refinement);
+
 // The warning of a verification rerun farther from the run than kDriftTolerance times its
 // tolerance, or that failed (options: as asked; refinement: what the run replaced, when it was
 // refined).

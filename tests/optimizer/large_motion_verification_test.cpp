@@ -13,40 +13,18 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "tests/support/l_frame.hpp"
 #include "tests/support/study_runs.hpp"
 
 namespace beamrail {
 namespace {
 
 using Json = nlohmann::json;
+using testing::l_frame;
 using testing::load_json;
 using testing::read_table;
 using testing::Table;
 using testing::warns_off_tolerance;
-
-Json l_frame(double speed, const Json& integrator) {
-  Json s = Json::parse(R"({
-    "name": "l_frame",
-    "scene": {
-      "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-      "sections": {"bar": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-      "bodies": [{"name": "tip", "mass": 1, "inertia": [1e-5, 1e-5, 1e-5], "position": [1, 0, 0]},
-                 {"name": "foot", "mass": 2, "inertia": [1e-4, 1e-4, 1e-4],
-                  "position": [1, -0.6, 0]}],
-      "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-                 "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "bar",
-                 "segments": 5},
-                {"name": "leg", "body1": "tip", "body2": "foot", "point1": [1, 0, 0],
-                 "point2": [1, -0.6, 0], "point3": [2, 0, 0], "material": "steel",
-                 "section": "bar", "segments": 3}],
-      "loads": [{"type": "force", "body": "tip", "value": [0, 0, -2]}]
-    },
-    "analyses": [{"type": "transient", "name": "swing", "t_end": 0.5, "output_step": 0.005}]
-  })");
-  s["scene"]["bodies"][0]["velocity"] = {0.0, 2.0 * speed, speed};
-  s["analyses"][0]["integrator"] = integrator;
-  return s;
-}
 
 // The largest distance between the runs' scene-body centres [m], the largest motion of a
 // reference centre [m], the largest angle between their orientations [rad] and the largest angle

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/l_frame.hpp"
 #include "tests/support/spinning_rotor.hpp"
 #include "tests/support/study_runs.hpp"
 
@@ -95,26 +96,7 @@ TEST_F(VerificationBeside, ARunThatFailsCancelsItsRerunAndReportsNone) {
 // from t = 0.014 s on (113 phases), is found off and refined. The results are those of the
 // rerun after the run, to the bit.
 TEST_F(VerificationBeside, AnAutoRunStartsItsRerunAtItsFirstRelinearization) {
-  const Json study_json = Json::parse(R"({
-    "name": "l_frame",
-    "scene": {
-      "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-      "sections": {"bar": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-      "bodies": [{"name": "tip", "mass": 1, "inertia": [1e-5, 1e-5, 1e-5], "position": [1, 0, 0],
-                  "velocity": [0, 2, 1]},
-                 {"name": "foot", "mass": 2, "inertia": [1e-4, 1e-4, 1e-4],
-                  "position": [1, -0.6, 0]}],
-      "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
-                 "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "bar",
-                 "segments": 5},
-                {"name": "leg", "body1": "tip", "body2": "foot", "point1": [1, 0, 0],
-                 "point2": [1, -0.6, 0], "point3": [2, 0, 0], "material": "steel",
-                 "section": "bar", "segments": 3}],
-      "loads": [{"type": "force", "body": "tip", "value": [0, 0, -2]}]
-    },
-    "analyses": [{"type": "transient", "name": "swing", "t_end": 0.5, "output_step": 0.005,
-                  "integrator": {"rtol": 1e-5}}]
-  })");
+  const Json study_json = testing::l_frame(1.0, {{"rtol", 1e-5}});
   const auto study = write_study("l_frame.json", study_json);
   run_ok(study, "beside", {"-j", "2"});
   run_ok(study, "after", {"-j", "1"});

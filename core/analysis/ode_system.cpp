@@ -48,6 +48,7 @@ int out_of_range(OdeContext* c, double t) {
   char when[48];
   std::snprintf(when, sizeof when, "at t = %.9g s, ", t);
   c->out_of_range = when + element_out_of_range(c->model, c->data);
+  c->out_of_range_t = t;
   if (++c->nonfinite_evaluations < kNonFiniteLimit) return 1;
   c->divergence = c->out_of_range;
   return -1;
@@ -135,6 +136,7 @@ int ode_project(double, N_Vector ycur, N_Vector corr, double, N_Vector err, void
 int ode_normalize(double t, N_Vector y, void* user_data) {
   auto* c = static_cast<OdeContext*>(user_data);
   normalize_quaternions(c->model, N_VGetArrayPointer(y));
+  c->accepted_t = t;
   if (c->step_taken) c->step_taken(t, N_VGetArrayPointer(y));
   return 0;
 }

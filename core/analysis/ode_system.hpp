@@ -49,6 +49,10 @@ struct OdeContext {
   // recoverable failure of the right-hand side), described: why the integrator gave up, if it
   // did so over failures of the right-hand side.
   std::string out_of_range;
+  double out_of_range_t = 0.0;  // its time [s]
+  // The time of the last step the integrator accepted (its post-step hook, ode_normalize) [s]:
+  // ARKODE's current time is a failed stage's.
+  double accepted_t = 0.0;
   // The end of the current stretch between the loads' breakpoints or t_end (the transient
   // analysis sets it): a jump there belongs to the next stretch, so the forces at or past it are
   // those just before it. A step's last stage (c = 1) at the jump once saw the load on: dirk and

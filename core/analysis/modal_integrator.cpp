@@ -277,7 +277,7 @@ class ModalExponential : public Integrator {
     const double rate = modal_elements_edge_rate(lambda, order_, swing, reach_, margins.length,
                                                  margins.angle, kEdgeShare);
     if (rate > 0.0) h = std::min(h, kResolvedPhase / rate);
-    return modal_slow_edge_step(lambda, edge_psi_a_, reach_, margins.length, margins.angle, h,
+    return modal_slow_edge_step(lambda, edge_psi_a_, phi_, reach_, margins.length, margins.angle, h,
                                 kSlowEdgeShare);
   }
 

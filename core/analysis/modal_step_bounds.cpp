@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/analysis/modal_coordinates.hpp"
@@ -62,13 +64,27 @@ double modal_ringing_rate(const Eigen::ArrayXd& lambda, const std::vector<Eigen:
   return 0.0;
 }
 
-ElementReach element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi) {
-  struct Lever {
-    int row1, row2;  // the first of the bodies' 6 rows in phi; -1: fixed
-    Vec3 arm1, arm2, span;
-    Vec3 free_axis;  // a cylindrical rail's axis, about which it turns freely; else zero
+namespace {
+
+// How far the offsets `v` (6 rows per free body) move the element of lever `l`: |d xi| and the
+// change of its relative rotation.
+std::pair<double, double> lever_motion(const ElementLever& l, const double* v) {
+  const auto part = [v](int row, int offset) {
+    return row >= 0 ? Vec3(v[row + offset], v[row + offset + 1], v[row + offset + 2])
+                    : Vec3::Zero();
   };
-  std::vector<Lever> levers;
+  const Vec3 turn1 = part(l.row1, 3), turn2 = part(l.row2, 3);
+  const Vec3 p1 = part(l.row1, 0) + turn1.cross(l.arm1);
+  const Vec3 p2 = part(l.row2, 0) + turn2.cross(l.arm2);
+  const Vec3 turn = turn2 - turn1;
+  return {(p2 - p1 - turn1.cross(l.span)).norm(),
+          (turn - turn.dot(l.free_axis) * l.free_axis).norm()};
+}
+
+}  // namespace
+
+ElementReach element_reach(const Model& model, const Data& data, const Eigen::MatrixXd& phi) {
+  ElementReach reach;
   const auto add = [&](const ElementEnds& ends, RotationMeasure measure, bool twist_free) {
     const ElementFrames<double> f =
         element_frames(ends, data.pose[ends.body1], data.pose[ends.body2], measure);
@@ -76,34 +92,33 @@ ElementReach element_reach(const Model& model, const Data& data, const Eigen::Ma
       const int free = model.bodies[body].free_index;
       return free >= 0 ? kDofsPerBody * free : -1;
     };
-    levers.push_back({row(ends.body1), row(ends.body2), f.R1, f.R2, f.lever1 - f.R1,
-                      twist_free ? Vec3(f.E1.col(0)) : Vec3::Zero()});
+    reach.levers.push_back({row(ends.body1), row(ends.body2), f.R1, f.R2, f.lever1 - f.R1,
+                            twist_free ? Vec3(f.E1.col(0)) : Vec3::Zero()});
   };
   for (const Beam& e : model.beams) add(e.ends, rotation_measure(e), false);
   for (const Rail& e : model.rails)
     add(e.ends, rotation_measure(e), e.type == RailType::kCylindrical);
-  const Eigen::Index modes = phi.cols(), elements = static_cast<Eigen::Index>(levers.size());
-  ElementReach reach{Eigen::ArrayXXd::Zero(modes, elements), Eigen::ArrayXXd::Zero(modes, elements),
-                     Eigen::ArrayX2d::Zero(modes, 2)};
-  for (Eigen::Index e = 0; e < elements; ++e) {
-    const Lever& l = levers[e];
-    for (Eigen::Index i = 0; i < modes; ++i) {
-      const auto part = [&](int row, int offset) {
-        return row >= 0 ? Vec3(phi.col(i).segment<3>(row + offset)) : Vec3::Zero();
-      };
-      const Vec3 turn1 = part(l.row1, 3), turn2 = part(l.row2, 3);
-      const Vec3 p1 = part(l.row1, 0) + turn1.cross(l.arm1);
-      const Vec3 p2 = part(l.row2, 0) + turn2.cross(l.arm2);
-      reach.length(i, e) = (p2 - p1 - turn1.cross(l.span)).norm();
-      const Vec3 turn = turn2 - turn1;
-      reach.angle(i, e) = (turn - turn.dot(l.free_axis) * l.free_axis).norm();
-    }
-  }
+  const Eigen::Index modes = phi.cols(), elements = static_cast<Eigen::Index>(reach.levers.size());
+  reach.length = reach.angle = Eigen::ArrayXXd::Zero(modes, elements);
+  reach.largest = Eigen::ArrayX2d::Zero(modes, 2);
+  for (Eigen::Index i = 0; i < modes; ++i)
+    for (Eigen::Index e = 0; e < elements; ++e)
+      std::tie(reach.length(i, e), reach.angle(i, e)) =
+          lever_motion(reach.levers[e], phi.col(i).data());
   if (elements > 0) {
     reach.largest.col(0) = reach.length.rowwise().maxCoeff();
     reach.largest.col(1) = reach.angle.rowwise().maxCoeff();
   }
   return reach;
+}
+
+void element_motion(const ElementReach& reach, const Eigen::Ref<const Eigen::VectorXd>& v,
+                    Eigen::ArrayXd* length, Eigen::ArrayXd* angle) {
+  const auto elements = static_cast<Eigen::Index>(reach.levers.size());
+  length->resize(elements);
+  angle->resize(elements);
+  for (Eigen::Index e = 0; e < elements; ++e)
+    std::tie((*length)[e], (*angle)[e]) = lever_motion(reach.levers[e], v.data());
 }
 
 Eigen::ArrayXd modal_swing(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& damping,
@@ -150,26 +165,31 @@ double modal_elements_edge_rate(const Eigen::ArrayXd& lambda,
 }
 
 double modal_slow_edge_step(const Eigen::ArrayXd& lambda, const Eigen::ArrayXd& accel,
-                            const ElementReach& reach, const std::vector<double>& length_margins,
+                            const Eigen::MatrixXd& phi, const ElementReach& reach,
+                            const std::vector<double>& length_margins,
                             const std::vector<double>& angle_margins, double h, double share) {
   const double slow = kResolvedPhase * kResolvedPhase;
-  Eigen::ArrayXd a = Eigen::ArrayXd::Zero(lambda.size());
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(lambda.size());
   bool any = false;
   for (Eigen::Index i = 0; i < lambda.size(); ++i)
-    if (!(lambda[i] * h * h > slow)) {
-      a[i] = std::abs(accel[i]);
-      any = any || a[i] > 0.0;
+    if (!(lambda[i] * h * h > slow) && accel[i] != 0.0) {
+      a[i] = accel[i];
+      any = true;
     }
   if (!any) return h;
-  const auto limit = [&](const Eigen::Ref<const Eigen::ArrayXd>& reach_e, double margin) {
-    const double drift = (reach_e * a).sum();  // sum_i reach_i |a_i|
+  // Their acceleration together: modes that cancel in an element (two bodies falling together,
+  // rigid modes that mix their common motion with their relative one) do not move it.
+  const Eigen::VectorXd offsets = phi * a;
+  Eigen::ArrayXd length, angle;
+  element_motion(reach, offsets, &length, &angle);
+  const auto limit = [&](double drift, double margin) {
     if (margin > 0.0 && drift * h * h / 8.0 > share * margin)
       h = std::sqrt(8.0 * share * margin / drift);
   };
   for (size_t e = 0; e < length_margins.size(); ++e) {
     const auto col = static_cast<Eigen::Index>(e);
-    limit(reach.length.col(col), length_margins[e]);
-    limit(reach.angle.col(col), angle_margins[e]);
+    limit(length[col], length_margins[e]);
+    limit(angle[col], angle_margins[e]);
   }
   return h;
 }

@@ -174,7 +174,8 @@ TEST(RangeWarnings, ACarriageFarOutOnARailWithoutATravelBetweenRowsIsWarnedOf) {
 // 0 for it, 1 for a prismatic one. A unit turn about z about the bob's centre moves point 2 by
 // (0, 0, 1) x (0, 0, 0.5) = 0: length 0, angle 1 for both. A unit slide along x moves it 1, no
 // angle. And the longest step over which those paths cannot carry the element across a quarter
-// of its margin m unseen (modal_slow_edge_step): sqrt(8 m / 4 / sum reach |a|).
+// of its margin m unseen (modal_slow_edge_step): sqrt(8 m / 4 / d), d how far the modes'
+// accelerations move it together.
 TEST(RangeWarnings, AModeMovesAnElementByItsEndsRelativeMotion) {
   for (const std::string type : {"cylindrical", "prismatic"}) {
     Scene s;
@@ -198,21 +199,30 @@ TEST(RangeWarnings, AModeMovesAnElementByItsEndsRelativeMotion) {
     EXPECT_NEAR(reach.length(2, 0), 1.0, 1e-12) << type;
     EXPECT_NEAR(reach.angle(2, 0), 0.0, 1e-12) << type;
     EXPECT_NEAR(reach.largest(1, 1), 1.0, 1e-12) << type;
-    // Three rigid modes accelerating at 2, 3 and 5 (units per s^2), margins 1 m and 0.4 rad:
-    // length sum 5 (the slide), angle sum 2 about_axis + 3, which decides.
+    // Three rigid modes accelerating at 2, -3 and 5 (units per s^2), margins 1 m and 0.4 rad:
+    // together they slide the carriage 5 and turn it (2, 0, -3), of which a cylindrical rail
+    // sees (0, 0, -3) (angle 3), a prismatic one all (sqrt 13): the angle decides.
     const Eigen::ArrayXd lambda = Eigen::ArrayXd::Zero(3);
     const Eigen::ArrayXd accel = (Eigen::ArrayXd(3) << 2.0, -3.0, 5.0).finished();
-    const double h = modal_slow_edge_step(lambda, accel, reach, {1.0}, {0.4}, 10.0, 0.25);
-    const double expected = std::min(std::sqrt(8.0 * 0.25 * 1.0 / 5.0),
-                                     std::sqrt(8.0 * 0.25 * 0.4 / (2.0 * about_axis + 3.0)));
-    EXPECT_NEAR(h, expected, 1e-12) << type;
+    const double angle = type == "cylindrical" ? 3.0 : std::sqrt(13.0);
+    EXPECT_NEAR(modal_slow_edge_step(lambda, accel, phi, reach, {1.0}, {0.4}, 10.0, 0.25),
+                std::min(std::sqrt(8.0 * 0.25 * 1.0 / 5.0), std::sqrt(8.0 * 0.25 * 0.4 / angle)),
+                1e-12)
+        << type;
     // A step already that short is left as it is; an oscillating mode the step does not resolve
     // (lambda h^2 above (pi / 8)^2) is not counted: only the slide's 5 remains in length.
-    EXPECT_EQ(modal_slow_edge_step(lambda, accel, reach, {0.1}, {0.4}, 0.01, 0.25), 0.01);
+    EXPECT_EQ(modal_slow_edge_step(lambda, accel, phi, reach, {0.1}, {0.4}, 0.01, 0.25), 0.01);
     const Eigen::ArrayXd turning = (Eigen::ArrayXd(3) << 1e4, 1e4, 0.0).finished();
-    EXPECT_NEAR(modal_slow_edge_step(turning, accel, reach, {0.1}, {0.4}, 1.0, 0.25),
+    EXPECT_NEAR(modal_slow_edge_step(turning, accel, phi, reach, {0.1}, {0.4}, 1.0, 0.25),
                 std::sqrt(8.0 * 0.25 * 0.1 / 5.0), 1e-12)
         << type;
+    // Two modes that slide it opposite ways at the same rate do not move it together.
+    Eigen::MatrixXd pair = Eigen::MatrixXd::Zero(6, 2);
+    pair.col(0) = phi.col(2);
+    pair.col(1) = -phi.col(2);
+    EXPECT_EQ(modal_slow_edge_step(Eigen::ArrayXd::Zero(2), Eigen::ArrayXd::Constant(2, 5.0), pair,
+                                   reach, {0.1}, {0.4}, 1.0, 0.25),
+              1.0);
   }
 }
 

@@ -303,6 +303,7 @@ class ModalExponential : public Integrator {
       case kInertia:
         return quasi_static_inertia_warning(quasi_static_inertia());
       case kOutOfRange:
+        if (!context_->divergence.empty()) return context_->divergence;  // between two steps
         return context_->out_of_range + " (the modal integrator could not step past it)";
       default:
         return "modal integrator flag " + std::to_string(flag);
@@ -823,7 +824,11 @@ class ModalExponential : public Integrator {
           ++stats_.steps;
           if (context_->step_taken) {  // every step that uses it writes its own states again
             coordinates_.states(t_, x_, watched_.data());
+            context_->path_bounded = true;
             context_->step_taken(t_, watched_.data());
+            context_->path_bounded = false;
+            // An element outside its law's range on the path between two steps (transient.cpp).
+            if (!context_->divergence.empty()) return kOutOfRange;
           }
           const double grow = err > 0.0 ? 0.9 * std::pow(err, -kExponent) : 4.0;
           if (h >= 0.999 * h_ || grow < 1.0) h_ = h * std::clamp(grow, 0.2, attempt ? 1.0 : 4.0);

@@ -70,6 +70,10 @@ struct OdeContext {
   // ARKODE's after each step (ode_normalize), CVODE's where it asks for the error weights of the
   // state it accepted (ode_error_weights), the modal method as it accepts a step.
   std::function<void(double t, const double* y)> step_taken;
+  // Set while the modal method calls step_taken: its steps, exact on the linear motion, may span
+  // many periods, and its own bounds see to its path between them (modal_step_bounds.hpp), so
+  // the path between its steps is not interpolated.
+  bool path_bounded = false;
   // CVODE's error weights 1 / (rtol |y_i| + atol), computed by its integrator (CVodeWFtolerances):
   // CVODE asks for them once per accepted step, with that step's state. Returns 0, or -1 where a
   // weight would be infinite.

@@ -554,5 +554,56 @@ TEST(TransientRange, APairFallingTogetherDoesNotHoldItsRailsSteps) {
   }
 }
 
+// Between two accepted steps of any method the path (a cubic through their positions and rates)
+// is checked at a quarter, half and three quarters of the step. The carriage thrown against a
+// constant 10 N (x = 0.3 + t - 5 t^2, top 0.35 m at 0.1 s) with its travel's end at 0.349 m is
+// outside from (1 - sqrt(0.02)) / 10 = 0.08586 s to 0.11414 s: bdf at rtol 1e-4 .. 1e-8 stepped
+// over it and reported ok (an adversarial review, 2026-12-02); every method now fails, the
+// time it names inside the excursion. Sent the other way against the force, with a min_length
+// of 0.251 m, it dips 1 mm below it at 0.1 s: warned by every method (bdf did not).
+TEST(TransientRange, AnExcursionBetweenTwoStepsOfAnyMethodEndsTheRun) {
+  const double exit = (1.0 - std::sqrt(0.02)) / 10.0;
+  for (const std::string method : {"auto", "modal", "bdf", "adams", "dirk", "erk"}) {
+    for (const double rtol : {1e-4, 1e-6, 1e-8}) {
+      for (const bool dip : {false, true}) {
+        Scene s;
+        s.material("steel", kE, kG).circle("rod", 0.04);
+        s.body("carriage", 1.0, Vec3(1e-3, 1e-3, 1e-3), Vec3(0.3, 0, 0));
+        s.last_body()["velocity"] = testing::vec(dip ? -1.0 : 1.0, 0, 0);
+        s.rail("guide", "prismatic", "ground", "carriage", Vec3::Zero(), Vec3(0.3, 0, 0), "steel",
+               "rod");
+        if (dip)
+          s.last_rail()["min_length"] = 0.251;
+        else
+          s.last_rail()["travel"] = {-1.0, 0.349};
+        s.force("carriage", Vec3(dip ? 10.0 : -10.0, 0, 0));
+        TransientOptions o = testing::range_options(method, 0.5, 0.5);
+        o.integrator.rtol = rtol;
+        o.integrator.atol = 1e-3 * rtol;
+        const auto run = simulate(s.model(), o);
+        const bool warned = std::any_of(
+            run.result.warnings.begin(), run.result.warnings.end(),
+            [](const std::string& w) { return w.find("min_length") != std::string::npos; });
+        std::printf("%s, %s, rtol %.0e: %s, %ld steps%s %s\n", dip ? "dip" : "top", method.c_str(),
+                    rtol, run.result.ok ? "ok" : "failed", run.result.stats.steps,
+                    warned ? ", warned" : "", run.result.message.c_str());
+        if (dip) {
+          EXPECT_TRUE(run.result.ok) << method << ": " << run.result.message;
+          EXPECT_TRUE(warned) << method << " rtol " << rtol;
+          continue;
+        }
+        EXPECT_FALSE(run.result.ok) << method << " rtol " << rtol;
+        EXPECT_NE(run.result.message.find("left the rail"), std::string::npos)
+            << method << ": " << run.result.message;
+        const size_t at = run.result.message.find("at t = ");
+        ASSERT_NE(at, std::string::npos) << run.result.message;
+        const double t = std::atof(run.result.message.c_str() + at + 7);
+        EXPECT_GT(t, exit - 1e-6) << method << " rtol " << rtol;
+        EXPECT_LT(t, 0.2 - exit + 1e-6) << method << " rtol " << rtol;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace beamrail

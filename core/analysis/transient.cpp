@@ -129,6 +129,13 @@ std::optional<IntegratorMethod> method_from_name(const std::string& name) {
 
 namespace {
 
+// A free body's Euler parameters in its 13 states `s`, and their rate 1/2 L(q) w (w in body
+// axes, as state_derivative).
+Vec4 euler_parameters(const double* s) { return Vec4(s[3], s[4], s[5], s[6]); }
+Vec4 euler_rate(const double* s) {
+  return 0.5 * quat_left_product_matrix(euler_parameters(s)) * Vec3(s[10], s[11], s[12]);
+}
+
 // The path between two steps is looked at k - 1 times, evenly, k from kPathSamples doubled
 // (up to kMostPathSamples) until what a path of acceleration a could pass its samples by unseen,
 // a (h / k)^2 / 8, is below kPathShare of the smallest margin of the elements (element_margins)
@@ -153,9 +160,8 @@ std::pair<double, double> path_accelerations(const Model& model, double h, const
     const double centre = std::max((6.0 * du - h * (4.0 * va + 2.0 * vb)).norm(),
                                    (-6.0 * du + h * (2.0 * va + 4.0 * vb)).norm()) /
                           (h * h);
-    const Vec4 qa(a[3], a[4], a[5], a[6]), qb(b[3], b[4], b[5], b[6]);
-    const Vec4 ra = 0.5 * quat_left_product_matrix(qa) * Vec3(a[10], a[11], a[12]);
-    const Vec4 rb = 0.5 * quat_left_product_matrix(qb) * Vec3(b[10], b[11], b[12]);
+    const Vec4 qa = euler_parameters(a), qb = euler_parameters(b);
+    const Vec4 ra = euler_rate(a), rb = euler_rate(b);
     const double turn = 2.0 *
                         std::max((6.0 * (qb - qa) - h * (4.0 * ra + 2.0 * rb)).norm(),
                                  (-6.0 * (qb - qa) + h * (2.0 * ra + 4.0 * rb)).norm()) /
@@ -185,9 +191,8 @@ void state_between(const Model& model, double t0, const double* y0, double t1, c
     double* o = out + kStatesPerBody * k;
     for (int i = 0; i < 3; ++i)
       o[i] = h00 * a[i] + h10 * h * a[7 + i] + h01 * b[i] + h11 * h * b[7 + i];
-    const Vec4 qa(a[3], a[4], a[5], a[6]), qb(b[3], b[4], b[5], b[6]);
-    const Vec4 ra = 0.5 * quat_left_product_matrix(qa) * Vec3(a[10], a[11], a[12]);
-    const Vec4 rb = 0.5 * quat_left_product_matrix(qb) * Vec3(b[10], b[11], b[12]);
+    const Vec4 qa = euler_parameters(a), qb = euler_parameters(b);
+    const Vec4 ra = euler_rate(a), rb = euler_rate(b);
     const Vec4 q = h00 * qa + h10 * h * ra + h01 * qb + h11 * h * rb;
     const Vec4 unit = q / q.norm();
     for (int i = 0; i < 4; ++i) o[3 + i] = unit[i];

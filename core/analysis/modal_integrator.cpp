@@ -419,9 +419,7 @@ class ModalExponential : public Integrator {
     multiply_transposed(phi_, m0_v_.data(), out);
   }
 
-  // One Newton correction of the quasi-static part: y += R M0 a, with Psi^T a given (psi_a;
-  // `first`: the evaluation's first; alternating corrections are summed:
-  // QuasiStaticModes::correct);
+  // One Newton correction of the quasi-static part: y += R M0 a, with Psi^T a given (psi_a);
   // returns its size in weights of the motion, rtol x + atol, x the largest offset from the
   // linearization (of the translations for theirs, of the rotations for theirs): the tolerance
   // a run's error is measured against (verify, work-precision studies). Not the step's weights,
@@ -437,9 +435,9 @@ class ModalExponential : public Integrator {
   // 1,000-segment cantilever 115 s (these 107 s, the step's weights 73 s) for the same error; these
   // weights with the iteration stopped at 1e-3 of them (kQuasiStaticTolerance) 84 s, but the bob 11
   // to 86 times off.
-  double correct(const Eigen::VectorXd& psi_a, Block& x, bool first) {
+  double correct(const Eigen::VectorXd& psi_a, Block& x) {
     m0_a_.noalias() = m0_ * acceleration_;
-    const Eigen::VectorXd& dy = quasi_.correct(m0_a_, psi_a, first);
+    const Eigen::VectorXd& dy = quasi_.correct(m0_a_, psi_a);
     x.col(0) += dy;
     double largest[2] = {0.0, 0.0};  // translations, rotations
     for (Eigen::Index r = 0; r < n_; ++r) {
@@ -521,37 +519,30 @@ class ModalExponential : public Integrator {
     out.col(0).setZero();
     double last_size = 0.0;
     bool updated_here = false;
-    int updated_at = -2;  // the iteration that updated the matrix: the next is not compared
-    int updates = 0;
     for (int iteration = 0;; ++iteration) {
       if (!evaluate(t, x, flag)) return false;
       psi_a_.resize(m_);
       multiply_transposed(phi_, m0_v_.data(), psi_a_.data());  // Phi^T M0 a
       // Quasi-static outside the band: corrected until the correction is a small part of the
       // tolerance (the accelerations of the last evaluation are kept).
-      const double size = correct(psi_a_, x, iteration == 0);
+      const double size = correct(psi_a_, x);
       // A correction that grows, or shrinks slowly, beyond the tolerance: the Newton matrix
-      // is updated to the tangent here, at most kQuasiStaticUpdates times per evaluation; if it
-      // grows after that, the state is too far out for the iteration (a trial step too long),
-      // which fails like non-finite forces: the step is retried shorter. One that stops
-      // shrinking within the tolerance is at its rounding floor. The first correction of an
-      // updated matrix is not weighed against the last of the old one. (Failing on a slow
-      // shrink after an update failed the cantilever of modal_band_test.cpp at rtol 1e-10 at a
-      // load's jump: 5.8 then 1.9 weights, converging.) One still beyond the tolerance after
-      // kQuasiStaticIterations fails too.
+      // is updated to the tangent here, once per evaluation; if it then grows, the state is
+      // too far out for the iteration (a trial step too long), which fails like non-finite
+      // forces: the step is retried shorter. One that stops shrinking within the tolerance is
+      // at its rounding floor. (Failing on a slow shrink after the update too failed the
+      // cantilever of modal_band_test.cpp at rtol 1e-10 at a load's jump: 5.8 then 1.9 weights,
+      // converging.) One still beyond the tolerance after kQuasiStaticIterations fails too.
       if (!std::isfinite(size) || (iteration >= kQuasiStaticIterations && size >= 1.0)) {
         *flag = kNonFinite;
         return false;
       }
-      if (iteration > 0 && iteration != updated_at + 1 &&
-          size > (updated_here ? 1.0 : 0.3) * last_size && size >= 1.0) {
-        if (updates >= kQuasiStaticUpdates || !update_tangent()) {
+      if (iteration > 0 && size > (updated_here ? 1.0 : 0.3) * last_size && size >= 1.0) {
+        if (updated_here || !update_tangent()) {
           *flag = kNonFinite;
           return false;
         }
         updated_here = true;
-        updated_at = iteration;
-        ++updates;
       }
       if (size < kQuasiStaticTolerance || iteration >= kQuasiStaticIterations ||
           (iteration > 0 && size > 0.5 * last_size && size < 1.0)) {
@@ -745,15 +736,6 @@ class ModalExponential : public Integrator {
   static constexpr double kQuasiStaticTolerance = 1e-5;
   // The corrections of one evaluation of the band's forcing at most.
   static constexpr int kQuasiStaticIterations = 8;
-  // The tangent updates of one evaluation at most (nonlinear()). A bending beam couples its
-  // lateral offsets to its axial force (EA times the slope), which K0 lacks and which a tangent
-  // of an earlier state has at another slope: along an evaluation's first correction the forces
-  // changed 2.0 to 2.1 times as fast as the Newton matrix said on the biaxially vibrating
-  // cantilever of QuasiStaticModes::correct, 4.1 to 4.5 times with K0 alone (a central
-  // difference along the correction). With one update, that cantilever in 32 segments failed at
-  // rtol 1e-4, 1e-6, 1e-7 and 1e-8 (after 15 to 36 steps: the corrections grew after the
-  // update); with two, it runs to 1 s in 100 to 125 steps from 1e-4 to 1e-7 (four: the same).
-  static constexpr int kQuasiStaticUpdates = 2;
   // A floating part is followed in a turning frame when it turns more than this over the run
   // [rad].
   static constexpr double kTurningFrameMinTurn = 1e-3;

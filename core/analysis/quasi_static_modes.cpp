@@ -38,7 +38,7 @@ bool QuasiStaticModes::init(const Eigen::SparseMatrix<double>& k0,
 }
 
 const Eigen::VectorXd& QuasiStaticModes::correct(const Eigen::VectorXd& m0_a,
-                                                 const Eigen::VectorXd& psi_a, bool first) {
+                                                 const Eigen::VectorXd& psi_a) {
   dy_ = k0_.solve(m0_a);
   if (updated_) {
     // With the tangent K of a later state: dy = K^-1 (M0 a - Psi l), Psi^T dy = 0.
@@ -51,16 +51,6 @@ const Eigen::VectorXd& QuasiStaticModes::correct(const Eigen::VectorXd& m0_a,
     work_m_ = psi_a.array() / (lambda_ + shift_);
     subtract_product(*phi_, work_m_, work_n_, dy_);
   }
-  const double last = first ? 0.0 : last_dy_.squaredNorm();
-  const double rho = last > 0.0 ? dy_.dot(last_dy_) / last : 0.0;
-  const bool along =
-      last > 0.0 && std::abs(dy_.dot(last_dy_)) >= kAlong * std::sqrt(last) * dy_.norm();
-  if (rho <= -kOvershoot && along) {
-    dy_ /= 1.0 - rho;
-    last_dy_.resize(0);  // the next correction is not a multiple of this one
-  } else {
-    last_dy_ = dy_;
-  }
   y_ += dy_;
   return dy_;
 }
@@ -69,7 +59,6 @@ bool QuasiStaticModes::update_tangent(const Eigen::SparseMatrix<double>& k) {
   const Eigen::SparseMatrix<double> symmetric =
       0.5 * Eigen::SparseMatrix<double>(k + Eigen::SparseMatrix<double>(k.transpose()));
   k0_.factorize(Eigen::SparseMatrix<double>(symmetric + shift_ * *m0_));
-  last_dy_.resize(0);  // corrections of another matrix
   if (k0_.info() != Eigen::Success || !(k0_.vectorD().array() > 0.0).all()) return false;
   const Eigen::MatrixXd psi = *m0_ * *phi_;
   kinv_psi_ = k0_.solve(psi);

@@ -40,19 +40,8 @@ class QuasiStaticModes {
             const Eigen::MatrixXd& phi, const Eigen::ArrayXd& lambda, double top);
 
   // One Newton correction dy = R M0 a for the accelerations a (m0_a = M0 a; psi_a = Phi^T M0 a),
-  // added to y; returns dy (valid until the next call). `first`: the first of an evaluation's
-  // corrections. Where the corrections alternate along one direction (dy = rho dy_last with
-  // rho <= -kOvershoot, the two within kAlong of parallel: the Newton matrix too soft along it by
-  // 1 - rho), dy is the sum of the series they would make, dy / (1 - rho), and the next is not
-  // compared with it. A bending beam's axial force, which changes with its lateral offsets by EA
-  // times its slope, makes them so (ModalExponential::kQuasiStaticUpdates): a cantilever (1 m of
-  // 10 mm steel, a 0.5 kg tip at 0.5 and 0.2 m/s across it, a 30 Hz band) in 32 segments failed
-  // with the corrections unsummed (and four updates) at rtol 1e-4 .. 1e-8 after 3 or 4 steps, and
-  // in 16 at 1e-7 and 1e-8; summed, both run to 1 s in 100 to 130 steps from 1e-4 to 1e-7 (16 also
-  // at 1e-8). Summed whatever their angle, the 32-segment runs failed at 1e-6 .. 1e-8
-  // (tests/core/analysis/modal_band_test.cpp).
-  const Eigen::VectorXd& correct(const Eigen::VectorXd& m0_a, const Eigen::VectorXd& psi_a,
-                                 bool first);
+  // added to y; returns dy (valid until the next call).
+  const Eigen::VectorXd& correct(const Eigen::VectorXd& m0_a, const Eigen::VectorXd& psi_a);
 
   // The Newton matrix from the tangent stiffness k of a later state (its symmetric part); false
   // when k + mu M0 is not positive definite.
@@ -97,11 +86,6 @@ class QuasiStaticModes {
   Eigen::MatrixXd kinv_psi_;  // K^-1 Psi
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_;  // of Psi^T K^-1 Psi
   Eigen::VectorXd y_, dy_, y_start_;
-  // The last correction of the current evaluation, where it was not summed (correct); empty:
-  // none.
-  Eigen::VectorXd last_dy_;
-  static constexpr double kOvershoot = 0.5;
-  static constexpr double kAlong = 0.9;  // |cos| of the angle between them, at least
   Eigen::VectorXd work_n_, work_m_, psi_dy_, m0_dy_;
   // The last accepted step's y at its start and at its last stage, and its size (0: none since
   // the start or a restart); the rate of y at the accepted state when rate_known_.

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <utility>
 
+#include "core/analysis/element_deformation.hpp"
 #include "core/analysis/modal_analysis.hpp"
 #include "core/analysis/modal_integrator.hpp"
 
@@ -144,7 +145,8 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
                        const Eigen::SparseMatrix<double>& m0,
                        const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& shifted, double mu,
                        const std::vector<BandExcitation>& excitations,
-                       const std::vector<int>& watched, double tolerance, double horizon) {
+                       const std::vector<int>& watched, double tolerance, double horizon,
+                       Eigen::Index fixed, Eigen::Index rigid_given) {
   const Eigen::Index total = lambda.size();
   BandChoice choice;
   if (total == 0) return choice;
@@ -153,9 +155,9 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
   Eigen::Index rigid = 0;
   double lowest_positive = 0.0;
   for (Eigen::Index i = 0; i < total; ++i) {
-    if (lambda(i) <= 1e-8 * top)
+    if (rigid_given >= 0 ? i < rigid_given : lambda(i) <= 1e-8 * top)
       rigid = i + 1;
-    else if (lowest_positive == 0.0)
+    else if (lowest_positive == 0.0 && lambda(i) > 0.0)
       lowest_positive = lambda(i);
   }
   // So do the modes a harmonic load could drive near resonance (w below kBandResonanceMargin
@@ -261,8 +263,8 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
     }
     tracks.push_back(std::move(t));
   }
-  if (!(scale[0] > 0.0) && !(scale[1] > 0.0) && least <= total) {  // nothing rings
-    choice.modes = least;
+  if (!(scale[0] > 0.0) && !(scale[1] > 0.0) && (least <= total || fixed > 0)) {  // nothing rings
+    choice.modes = fixed > 0 ? fixed : least;
     choice.met = true;
     return choice;
   }
@@ -302,12 +304,13 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
         squares[i](r, k) = squares[i](r, k + 1) + ring * ring;
       }
   }
-  for (Eigen::Index m = least; m <= total; ++m) {
+  for (Eigen::Index m = fixed > 0 ? std::min(std::max(fixed, rigid), total) : least; m <= total;
+       ++m) {
     // At the last mode given, a twin not given may lie just above: only a complete basis ends
-    // there.
-    const bool boundary =
-        m == total ? complete
-                   : lambda(m) - lambda(m - 1) > 1e-6 * std::abs(lambda(m)) + 1e-10 * top;
+    // there (a band given ends where it is given).
+    const bool boundary = fixed > 0 || (m == total ? complete
+                                                   : lambda(m) - lambda(m - 1) >
+                                                         1e-6 * std::abs(lambda(m)) + 1e-10 * top);
     if (!boundary) continue;
     double dropped[2] = {0.0, 0.0};
     for (size_t i = 0; i < tracks.size(); ++i) {
@@ -319,8 +322,8 @@ BandChoice choose_band(const Eigen::VectorXd& lambda, const Eigen::MatrixXd& phi
     choice.modes = m;
     choice.estimate = std::max(scale[0] > 0.0 ? dropped[0] / scale[0] : 0.0,
                                scale[1] > 0.0 ? dropped[1] / scale[1] : 0.0);
-    if (choice.estimate <= tolerance) {
-      choice.met = true;
+    if (choice.estimate <= tolerance || fixed > 0) {
+      choice.met = choice.estimate <= tolerance;
       return choice;
     }
   }
@@ -397,18 +400,28 @@ bool solve_band_modes(const Model& model, const Data& data, double t0,
   Eigen::MatrixXd& vectors = out.vectors;
   out = BandModes();
   BandChoice chosen;
-  const auto estimate = [&]() {
+  const auto estimate = [&](Eigen::Index fixed = 0) {
+    // A given band's rigid and mechanism modes: the lowest that deform no element (choose_band).
+    Eigen::Index rigid = -1;
+    if (fixed > 0) {
+      const ElementDeformation deformation(model, data);
+      rigid = 0;
+      while (rigid < values.size() &&
+             deformation.ratio(vectors.col(rigid)) <= kRigidModeDeformation)
+        ++rigid;
+    }
     // A shift of a hundredth of the lowest positive w^2 keeps rigid and mechanism modes
     // regular (they are kept).
     const double top = values.cwiseAbs().maxCoeff();
     double mu = 0.0;
-    for (Eigen::Index i = 0; i < values.size() && mu == 0.0; ++i)
-      if (values(i) > 1e-8 * top) mu = 0.01 * values(i);
+    for (Eigen::Index i = std::max<Eigen::Index>(rigid, 0); i < values.size() && mu == 0.0; ++i)
+      if (rigid >= 0 ? values(i) > 0.0 : values(i) > 1e-8 * top) mu = 0.01 * values(i);
     if (mu == 0.0) mu = 1.0;
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> shifted(
         Eigen::SparseMatrix<double>(k0 + mu * m0));
     if (shifted.info() != Eigen::Success) return false;
-    chosen = choose_band(values, vectors, m0, shifted, mu, excitations, watched, rtol, horizon);
+    chosen = choose_band(values, vectors, m0, shifted, mu, excitations, watched, rtol, horizon,
+                         fixed, rigid);
     return true;
   };
   // Every mode from the dense eigensolver (and the band chosen from them).
@@ -493,6 +506,10 @@ bool solve_band_modes(const Model& model, const Data& data, double t0,
   } else {
     out.kept = 0;
     while (out.kept < values.size() && values(out.kept) <= limit) ++out.kept;
+    // What the given band drops, by the same estimate (a band below the ringing of an initial
+    // velocity or a load's jump once said only what the quasi-static modes' inertia left).
+    if (out.kept > 0 && out.kept < n && !excitations.empty() && estimate(out.kept))
+      out.given_estimate = chosen.estimate;
   }
   out.top = limit;
   if (out.kept == 0)

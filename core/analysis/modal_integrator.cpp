@@ -329,10 +329,11 @@ class ModalExponential : public Integrator {
     m0_ = mass_matrix(model, data);
     std::vector<BandExcitation> excitations;
     const std::vector<int> watched = watched_bodies(model);
-    if (choose) {
-      // The force out of balance at the initial state (what makes an offset from the
-      // linearization ring; with the kinematics of the motion, unlike the offset itself, whose
-      // second-order parts, such as a bent beam's shortening, follow the bending instead).
+    {
+      // What rings (for a chosen band's choice and a given one's estimate): the force out of
+      // balance at the initial state (what makes an offset from the linearization ring; with the
+      // kinematics of the motion, unlike the offset itself, whose second-order parts, such as a
+      // bent beam's shortening, follow the bending instead) and its velocity.
       const Data linearized = data;
       Block x;
       coordinates_.offsets(t0, y0, x);
@@ -358,6 +359,16 @@ class ModalExponential : public Integrator {
       band_hz_ = std::sqrt(limit) / (2.0 * M_PI);
       band_needed_ = band.needed;
       band_estimate_ = band.estimate;
+    } else if (band.given_estimate > options_.rtol) {
+      char text[500];
+      std::snprintf(text, sizeof text,
+                    "band-limited run (%.4g Hz): the modes above the band would ring with about "
+                    "%.2g of the motion (estimated from the initial state and the loads' changes "
+                    "as for a band chosen for rtol), above rtol; the run keeps them quasi-static "
+                    "and leaves that out: a higher max_frequency_hz, \"auto\" (the band chosen "
+                    "for rtol) or every mode",
+                    band_hz_, band.given_estimate);
+      warnings.push_back(text);
     }
     const Eigen::MatrixXd& vectors = band.vectors;
     phi_ = vectors.leftCols(m_);

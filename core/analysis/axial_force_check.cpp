@@ -296,7 +296,7 @@ double MissingAxialForces::element_ratio_bound() const {
 }
 
 AxialForceEffect deformation_axial_force_effect(
-    const Model& model, const Data& data, const MissingAxialForces& missing,
+    const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve) {
   AxialForceEffect effect;
   if (!missing.any()) return effect;

@@ -126,7 +126,7 @@ AxialForceEffect static_axial_force_effect(
 // kAxialForceFloor^2 of the most bent one's energy; the largest, and that beam. Where the
 // fixed-point iteration diverges, of the first-order e = -S^-1 g0. `unstable` is not measured.
 AxialForceEffect deformation_axial_force_effect(
-    const Model& model, const Data& data, const MissingAxialForces& missing,
+    const MissingAxialForces& missing,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& solve);
 
 // The warning for a transient's state at time t [s], "" below kAxialForceWarning.

@@ -56,7 +56,7 @@ void AxialForceWatch::observe(const Model& model, const Data& data, long index, 
   }
   ++measured_;
   const AxialForceEffect effect = deformation_axial_force_effect(
-      model, data, missing, [&](const Eigen::VectorXd& b) { return solver_->solve(b); });
+      missing, [&](const Eigen::VectorXd& b) { return solver_->solve(b); });
   if (!(effect.relative > largest_)) return;
   largest_ = effect.relative;
   when_ = t;

@@ -177,6 +177,24 @@ class AutoIntegrator : public Integrator {
         if (!widen_band(*t, y)) return kAutoFailed;
         continue;
       }
+      if (flag == 0 && modal_ && mechanism_) {
+        const long steps = current_->stats().steps, held = modal_held_steps(*current_);
+        const double dofs = static_cast<double>(context_->model.n_dofs);
+        if (held >= kAutoHeldSteps && static_cast<double>(held) >= kAutoHeldShare * steps &&
+            static_cast<double>(held) * dofs * dofs >= kAutoHeldWork) {
+          before_ = sum(before_, current_->stats());
+          std::string error;
+          if (!start_method(IntegratorMethod::kDirk, "", *t, y,
+                            "a mechanism whose modal steps its stiff modes' ringing held short (" +
+                                std::to_string(held) + " of " + std::to_string(steps) +
+                                " steps at less than " + number(kMechanismHeldShare) +
+                                " of the step its estimates asked for): dirk steps over that "
+                                "ringing",
+                            &error))
+            return fail(error);
+          continue;
+        }
+      }
       if (flag != kModalTooFar || !modal_) return flag;
       const std::string who = quoted(current_->failure(flag));
       const long steps = current_->stats().steps;

@@ -206,6 +206,7 @@ class ModalExponential : public Integrator {
   const Eigen::ArrayXd& damping() const { return blocks_.damping; }
   double damping_coupling() const { return damping_coupling_; }
   double step_size() const { return h_; }
+  long held_steps() const { return held_steps_; }
 
   // The largest rotation of a body from the linearization at the accepted state [rad].
   double largest_rotation() const { return coordinates_.largest_rotation(x_); }
@@ -782,7 +783,9 @@ class ModalExponential : public Integrator {
         double h = std::min(h_, target - t_);
         if (options_.max_step > 0.0) h = std::min(h, options_.max_step);
         const bool mechanism_holds = mechanism_bound(ringing);
+        const double asked = h;
         h = bounds_.limit(h, h_, mechanism_holds, mechanism_holds ? 0.0 : ringing_rate(ringing));
+        const bool held = h < kMechanismHeldShare * asked;
         h = std::min(h, edge_h);
         // Land on the target instead of leaving a sliver.
         if (t_ + 1.05 * h >= target) h = target - t_;
@@ -833,6 +836,7 @@ class ModalExponential : public Integrator {
           have_n0_ = false;
           starting_ = false;
           ++stats_.steps;
+          if (held) ++held_steps_;
           if (context_->step_taken) {  // every step that uses it writes its own states again
             coordinates_.states(t_, x_, watched_.data());
             context_->path_bounded = true;
@@ -945,6 +949,7 @@ class ModalExponential : public Integrator {
   std::vector<double> y13_, ydot13_;
   std::vector<double> watched_;  // an accepted step's states, for OdeContext::step_taken
   SolverStats stats_;
+  long held_steps_ = 0;  // accepted steps the mechanism's bounds held (kMechanismHeldShare)
   int far_body_ = -1;
   std::string detail_;
   double max_rotation_ = kModalIntegratorMaxRotation;
@@ -1031,6 +1036,11 @@ void hold_modal_mechanism_bound(Integrator& integrator) {
 double modal_step_size(const Integrator& integrator) {
   const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
   return modal ? modal->step_size() : 0.0;
+}
+
+long modal_held_steps(const Integrator& integrator) {
+  const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
+  return modal ? modal->held_steps() : 0;
 }
 
 std::unique_ptr<Integrator> make_modal_integrator(const IntegratorOptions& options,

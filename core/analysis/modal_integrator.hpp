@@ -137,6 +137,10 @@ bool set_modal_inertia_limit(Integrator& integrator, double drift);
 
 // The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
 double modal_step_size(const Integrator& integrator);
+// Its accepted steps that a mechanism's bounds held below kMechanismHeldShare of the step the
+// error estimates and the other limits asked for (core/analysis/modal_step_bounds.hpp); 0 when
+// `integrator` is not one.
+long modal_held_steps(const Integrator& integrator);
 
 // Whether a modal integrator's mechanism step bound (kMechanismStep) holds at its accepted state:
 // a mechanism whose stiff modes hold energy.

@@ -66,6 +66,11 @@ inline constexpr double kMechanismStiffShare = 1e-8;
 // were far too long (421 / 316 / 1,800 rtol off before the bound), and it came out 41 / 890 /
 // 33 rtol off at 10 times, 22 / 11 / 14 at 30, 0.004 / 0.07 / 4.0 at 100.
 inline constexpr double kMechanismMostShorter = 100.0;
+// A step the mechanism's bounds held below this part of the estimates' step counts as held
+// (modal_held_steps, core/analysis/modal_integrator.hpp): where they hold nearly every step so,
+// the stiff modes' ringing, not the motion, sets the steps (auto then goes on with an implicit
+// method: core/analysis/auto_integrator.hpp, kAutoHeldSteps).
+inline constexpr double kMechanismHeldShare = 1.0 / 30.0;
 // A mechanism's slower modes ring too, and the remainder carries their ringing into the motion
 // (a joint's tension rings in its axial mode and pulls on the swing with it): the estimates
 // sample that forcing at the stages of a step and do not see a step that skips its periods.

@@ -383,6 +383,7 @@ class ModalExponential : public Integrator {
       return fail(error,
                   "a band-limited run (max_frequency_hz): the stiffness where it is linearized "
                   "has a mode of negative stiffness below the band's");
+    quasi_.set_forcing_rate(2.0 * M_PI * highest_harmonic_hz(model));
     return true;
   }
 

@@ -93,7 +93,8 @@ QuasiStaticInertia QuasiStaticModes::inertia(double band_hz, double t, double el
   q.t = t;
   if (!(band_kinetic_ > 0.0)) return q;
   q.ratio = kinetic_ / band_kinetic_;
-  q.drift = 0.5 * q.ratio * std::max(1.0, std::sqrt(std::max(0.0, lowest_elastic_)) * elapsed);
+  const double w = std::max(std::sqrt(std::max(0.0, lowest_elastic_)), forcing_rate_);
+  q.drift = 0.5 * q.ratio * std::max(1.0, w * elapsed);
   return q;
 }
 

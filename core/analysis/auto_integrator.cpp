@@ -147,6 +147,7 @@ class AutoIntegrator : public Integrator {
       // state reached) hands over there: the implicit or explicit method starts with the next
       // call (SUNDIALS refuses a stop time at its start).
       if (switched && !modal_ && *t >= std::min(tout, tstop)) return 0;
+      if (modal_ && mechanism_) set_modal_held_limit(*current_, held_limit());
       const int flag = current_->advance(tout, tstop, y, t);
       if (modal_ && (flag == kModalStepTooSmall || flag == kModalNonFinite) &&
           !context_->timed_out && !context_->interrupted && context_->callback_error.empty()) {
@@ -177,23 +178,22 @@ class AutoIntegrator : public Integrator {
         if (!widen_band(*t, y)) return kAutoFailed;
         continue;
       }
-      if (flag == 0 && modal_ && mechanism_) {
-        const long steps = current_->stats().steps, held = modal_held_steps(*current_);
-        const double dofs = static_cast<double>(context_->model.n_dofs);
-        if (held >= kAutoHeldSteps && static_cast<double>(held) >= kAutoHeldShare * steps &&
-            static_cast<double>(held) * dofs * dofs >= kAutoHeldWork) {
-          before_ = sum(before_, current_->stats());
-          std::string error;
-          if (!start_method(IntegratorMethod::kDirk, "", *t, y,
-                            "a mechanism whose modal steps its stiff modes' ringing held short (" +
-                                std::to_string(held) + " of " + std::to_string(steps) +
-                                " steps at less than " + number(kMechanismHeldShare) +
-                                " of the step its estimates asked for): dirk steps over that "
-                                "ringing",
-                            &error))
-            return fail(error);
-          continue;
-        }
+      if (flag == kModalHeld && modal_) {
+        const HeldSteps stretch = modal_held_steps(*current_);
+        const long steps = current_->stats().steps;
+        before_ = sum(before_, current_->stats());
+        std::string error;
+        if (!start_method(IntegratorMethod::kDirk, "", *t, y,
+                          "a mechanism whose modal steps its stiff modes' ringing held short (" +
+                              std::to_string(stretch.held) + " of its last " +
+                              std::to_string(stretch.steps) + " steps, of " +
+                              std::to_string(steps) + ", at less than " +
+                              number(kMechanismHeldShare) +
+                              " of the step its estimates asked for): dirk steps over that "
+                              "ringing",
+                          &error))
+          return fail(error);
+        continue;
       }
       if (flag != kModalTooFar || !modal_) return flag;
       const std::string who = quoted(current_->failure(flag));
@@ -272,6 +272,13 @@ class AutoIntegrator : public Integrator {
   std::string failure(int flag) const override {
     if (flag == kAutoFailed) return failure_;
     return current_->failure(flag);
+  }
+
+  // The held steps after which a mechanism's modal phase goes on with dirk (kAutoHeldSteps, and
+  // kAutoHeldWork over the products' cost, the degrees of freedom squared).
+  long held_limit() const {
+    const double dofs = static_cast<double>(context_->model.n_dofs);
+    return std::max(kAutoHeldSteps, static_cast<long>(std::ceil(kAutoHeldWork / (dofs * dofs))));
   }
 
   // The dropped inertia of the band-limited modal phases: their drifts add up.

@@ -91,20 +91,19 @@ inline constexpr double kAutoMaxDampingRatio = 0.1;
 // s, 4.3 / 25 / 29 rtol at rtol 1e-4 / 1e-6 / 1e-8, then 2.1 / 8.2 / 3.8.
 inline constexpr double kAutoExplicitResolved = 0.45;
 // A modal phase of a mechanism whose steps the mechanism's bounds held below kMechanismHeldShare
-// of the estimates' step (core/analysis/modal_step_bounds.hpp) this many times, at least
-// kAutoHeldShare of its steps, goes on with dirk (the default table) from there: the ringing of
-// stiff modes that the motion barely feels (a joint's penalty, a segment's torsion) then sets the
-// modal steps, and an L-stable method steps over it. A 0.5 m steel rod of 10 mm in 100 segments
-// with a 0.5 kg tip, on a revolute joint through a 0.1 kg hub, released level under gravity (0.3
-// s, rtol 1e-6): auto held every modal step from 0.02 s on at 5.9e-7 s (the 100-times floor, the
-// estimates asking for 5.3e-5 s) and took 414 s in 536,232 steps; dirk alone 34.5 s in 31,007
-// (docs/transient_measurements.md "Mechanisms held by their stiff ringing"). Only where those
-// steps are work: held steps times the degrees of freedom squared (a modal step's products) at
-// least kAutoHeldWork, about a second of them; a small scene's held steps are cheap, and an
-// implicit method's are not (the stiff-hinge pendulum of tests/support/scenes.hpp: its modal
-// steps are not held, 608,454 in 1.9 s; ESDIRK547 took 38.6 s).
+// of the estimates' step (core/analysis/modal_step_bounds.hpp) this many times in its latest
+// stretch of steps held at least kMechanismHeldStretch (modal_held_steps), goes on with dirk (the
+// default table) from there: the ringing of stiff modes that the motion barely feels (a joint's
+// penalty, a segment's torsion) then sets the modal steps, and an L-stable method steps over it. A
+// 0.5 m steel rod of 10 mm in 100 segments with a 0.5 kg tip, on a revolute joint through a 0.1 kg
+// hub, released level under gravity (0.3 s, rtol 1e-6): auto held every modal step from 0.02 s on
+// at 5.9e-7 s (the 100-times floor, the estimates asking for 5.3e-5 s) and took 414 s in 536,232
+// steps; dirk alone 34.5 s in 31,007 (docs/transient_measurements.md "Mechanisms held by their
+// stiff ringing"). Only where those steps are work: held steps times the degrees of freedom squared
+// (a modal step's products) at least kAutoHeldWork, about a second of them; a small scene's held
+// steps are cheap, and an implicit method's are not (the stiff-hinge pendulum of
+// tests/support/scenes.hpp: its modal steps are not held, 608,454 in 1.9 s; ESDIRK547 took 38.6 s).
 inline constexpr long kAutoHeldSteps = 2000;
-inline constexpr double kAutoHeldShare = 0.9;
 inline constexpr double kAutoHeldWork = 5e8;
 // The explicit method auto hands over to (kAutoExplicitResolved).
 inline constexpr const char* kAutoExplicitTable = "VERNER_8_5_6";

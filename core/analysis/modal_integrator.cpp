@@ -49,7 +49,8 @@ enum Flag {
   kNonFinite = kModalNonFinite,
   kTooFar = kModalTooFar,
   kInertia = kModalInertia,
-  kOutOfRange = kModalOutOfRange
+  kOutOfRange = kModalOutOfRange,
+  kHeld = kModalHeld
 };
 
 class ModalExponential : public Integrator {
@@ -147,9 +148,10 @@ class ModalExponential : public Integrator {
       if (flag == kOk && inertia_limit_ > 0.0 && inertia_settled() &&
           quasi_static_inertia().drift > inertia_limit_)
         flag = kInertia;
+      if (flag == kOk && held_limit_ > 0 && held_.held >= held_limit_) flag = kHeld;
     }
     // The quasi-static part of the state reported (kept for the next step), and its rate.
-    if ((flag == kOk || flag == kInertia) && reduced_ && !have_n0_) {
+    if ((flag == kOk || flag == kInertia || flag == kHeld) && reduced_ && !have_n0_) {
       try {
         const int reached = flag;
         if (!nonlinear(t_, z_, x_, n0_, &flag)) flag = fail_flag(flag);
@@ -206,7 +208,7 @@ class ModalExponential : public Integrator {
   const Eigen::ArrayXd& damping() const { return blocks_.damping; }
   double damping_coupling() const { return damping_coupling_; }
   double step_size() const { return h_; }
-  long held_steps() const { return held_steps_; }
+  HeldSteps held_steps() const { return held_; }
 
   // The largest rotation of a body from the linearization at the accepted state [rad].
   double largest_rotation() const { return coordinates_.largest_rotation(x_); }
@@ -303,6 +305,14 @@ class ModalExponential : public Integrator {
         return detail_;
       case kInertia:
         return quasi_static_inertia_warning(quasi_static_inertia());
+      case kHeld: {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the mechanism's bounds held %ld of its last %ld steps below %g of the step "
+                      "its estimates asked for",
+                      held_.held, held_.steps, kMechanismHeldShare);
+        return text;
+      }
       case kOutOfRange:
         if (!context_->divergence.empty()) return context_->divergence;  // between two steps
         return context_->out_of_range + " (the modal integrator could not step past it)";
@@ -837,7 +847,11 @@ class ModalExponential : public Integrator {
           have_n0_ = false;
           starting_ = false;
           ++stats_.steps;
-          if (held) ++held_steps_;
+          ++held_.steps;
+          if (held)
+            ++held_.held;
+          else if (static_cast<double>(held_.held) < kMechanismHeldStretch * held_.steps)
+            held_ = {};
           if (context_->step_taken) {  // every step that uses it writes its own states again
             coordinates_.states(t_, x_, watched_.data());
             context_->path_bounded = true;
@@ -865,6 +879,10 @@ class ModalExponential : public Integrator {
   // advance() stops (kInertia) after the step whose drift first passes `drift` (0: never), once
   // inertia_settled().
   void set_inertia_limit(double drift) { inertia_limit_ = drift; }
+
+  // advance() stops (kHeld) after the step at which the held steps of the latest stretch reach
+  // `held` (0: never).
+  void set_held_limit(long held) { held_limit_ = held; }
 
   // Whether the band's slowest elastic mode has turned kInertiaSettling rad since the run began.
   // Before, a load that starts from rest gives a ratio of kinetic energies far above the
@@ -942,6 +960,7 @@ class ModalExponential : public Integrator {
   int fill_stage_ = 0;  // the stage (kStages: the new state) whose pass is under way, and
   const StepFunctions* fill_functions_ = nullptr;  // the functions of its step
   double inertia_limit_ = 0.0;                     // set_inertia_limit
+  long held_limit_ = 0;                            // set_held_limit
   Eigen::VectorXd acceleration_;  // work space: the physical accelerations of a stage
   double t_ = 0.0, h_ = 0.0;
   double t0_ = 0.0;  // where the run started
@@ -950,7 +969,8 @@ class ModalExponential : public Integrator {
   std::vector<double> y13_, ydot13_;
   std::vector<double> watched_;  // an accepted step's states, for OdeContext::step_taken
   SolverStats stats_;
-  long held_steps_ = 0;  // accepted steps the mechanism's bounds held (kMechanismHeldShare)
+  HeldSteps
+      held_;  // the latest stretch of steps the mechanism's bounds held (kMechanismHeldStretch)
   int far_body_ = -1;
   std::string detail_;
   double max_rotation_ = kModalIntegratorMaxRotation;
@@ -1025,6 +1045,13 @@ bool set_modal_inertia_limit(Integrator& integrator, double drift) {
   return true;
 }
 
+bool set_modal_held_limit(Integrator& integrator, long held) {
+  auto* modal = dynamic_cast<ModalExponential*>(&integrator);
+  if (!modal) return false;
+  modal->set_held_limit(held);
+  return true;
+}
+
 bool modal_mechanism_bound(const Integrator& integrator) {
   const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
   return modal && modal->mechanism_bound();
@@ -1039,9 +1066,9 @@ double modal_step_size(const Integrator& integrator) {
   return modal ? modal->step_size() : 0.0;
 }
 
-long modal_held_steps(const Integrator& integrator) {
+HeldSteps modal_held_steps(const Integrator& integrator) {
   const auto* modal = dynamic_cast<const ModalExponential*>(&integrator);
-  return modal ? modal->held_steps() : 0;
+  return modal ? modal->held_steps() : HeldSteps{};
 }
 
 std::unique_ptr<Integrator> make_modal_integrator(const IntegratorOptions& options,

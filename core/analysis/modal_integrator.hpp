@@ -96,6 +96,10 @@ inline constexpr int kModalInertia = -21;
 // one call, or because the step fell below the roundoff of the time while they did: the element
 // left its law where the run stopped (y and t: the last accepted state, inside the range).
 inline constexpr int kModalOutOfRange = -22;
+// The flag of a mechanism's run stopped because the held steps of its latest stretch
+// (modal_held_steps) reached the limit of set_modal_held_limit (y and t: the step's accepted
+// state where they did).
+inline constexpr int kModalHeld = -23;
 
 // The angular velocity of the fastest frame in which a modal integrator follows a floating part
 // of the scene that spins (core/analysis/modal_coordinates.hpp) [rad/s]; 0 in fixed axes or for
@@ -137,10 +141,19 @@ bool set_modal_inertia_limit(Integrator& integrator, double drift);
 
 // The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
 double modal_step_size(const Integrator& integrator);
-// Its accepted steps that a mechanism's bounds held below kMechanismHeldShare of the step the
-// error estimates and the other limits asked for (core/analysis/modal_step_bounds.hpp); 0 when
-// `integrator` is not one.
-long modal_held_steps(const Integrator& integrator);
+// The latest stretch of accepted steps in which a mechanism's bounds held at least
+// kMechanismHeldStretch of them below kMechanismHeldShare of the step the error estimates and the
+// other limits asked for (core/analysis/modal_step_bounds.hpp): its steps and the held ones.
+struct HeldSteps {
+  long held = 0;
+  long steps = 0;
+};
+// That stretch of `integrator`'s steps; none when it is not a modal integrator.
+HeldSteps modal_held_steps(const Integrator& integrator);
+// Makes a modal integrator stop (kModalHeld) after the step at which the held steps of its latest
+// stretch reach `held` (0: never, the default); false when `integrator` is not a modal
+// integrator.
+bool set_modal_held_limit(Integrator& integrator, long held);
 
 // Whether a modal integrator's mechanism step bound (kMechanismStep) holds at its accepted state:
 // a mechanism whose stiff modes hold energy.

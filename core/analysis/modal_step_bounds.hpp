@@ -69,8 +69,15 @@ inline constexpr double kMechanismMostShorter = 100.0;
 // A step the mechanism's bounds held below this part of the estimates' step counts as held
 // (modal_held_steps, core/analysis/modal_integrator.hpp): where they hold nearly every step so,
 // the stiff modes' ringing, not the motion, sets the steps (auto then goes on with an implicit
-// method: core/analysis/auto_integrator.hpp, kAutoHeldSteps).
-inline constexpr double kMechanismHeldShare = 1.0 / 30.0;
+// method: core/analysis/auto_integrator.hpp, kAutoHeldSteps). A tenth, not a thirtieth: a
+// 40-segment rod on a spherical joint (docs/transient_measurements.md "Held steps counted from
+// where the hold begins") had every step from 0.01 s on held 17 times below its estimates' step
+// (the stiff modes' bound, 1.9 / w_max at w_max 1.3e8 rad/s) and was not counted.
+inline constexpr double kMechanismHeldShare = 0.1;
+// The held steps are counted over the latest stretch of accepted steps in which at least this
+// share was held (a step not held that brings the share below it starts a new stretch): a phase
+// that ran free for a while before the hold began counts from where it began.
+inline constexpr double kMechanismHeldStretch = 0.9;
 // A mechanism's slower modes ring too, and the remainder carries their ringing into the motion
 // (a joint's tension rings in its axial mode and pulls on the swing with it): the estimates
 // sample that forcing at the stages of a step and do not see a step that skips its periods.

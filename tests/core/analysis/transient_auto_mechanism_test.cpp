@@ -381,6 +381,51 @@ TEST(TransientAuto, AMechanismHeldByItsStiffModesRingingGoesOnWithDirk) {
   EXPECT_LT(e, rtol);
 }
 
+// The held steps are counted from where the hold begins, at every step (kMechanismHeldStretch,
+// set_modal_held_limit): the rod above on a spherical joint, its tip started at 1 m/s across, runs
+// free for 35,000 modal steps; from 0.01 s on the stiff modes' bound (1.9 / w_max, w_max 1.3e8
+// rad/s) holds every step 17 times below the estimates' 2.6e-7 s. Counted over the whole phase at
+// 1/30 of the estimates' step, at each 5 ms output, it was never handed over: 0.02 s took 695,378
+// steps, 98 s (dirk alone 18 s); now dirk goes on after 8,263 held steps (kAutoHeldWork).
+TEST(TransientAuto, HeldStepsCountFromWhereTheHoldBegins) {
+  const Model arm = scene_from_json(R"({
+    "gravity": [0, -9.81, 0],
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "hub", "mass": 0.1, "inertia": [1e-4, 1e-4, 1e-4], "position": [0, 0, 0]},
+               {"name": "tip", "mass": 0.5, "inertia": [1e-4, 1e-4, 1e-4], "position": [0.5, 0, 0],
+                "velocity": [0, 0, 1]}],
+    "beams": [{"name": "arm", "body1": "hub", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [0.5, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
+               "segments": 40}],
+    "joints": [{"name": "s", "type": "spherical", "body1": "ground", "body2": "hub",
+                "point": [0, 0, 0]}]})");
+  const double t_end = 0.0105, rtol = 1e-6;
+  TransientOptions o = options(t_end, t_end, 1e-7, 1e-10);
+  o.integrator.method = IntegratorMethod::kDirk;
+  const TransientRun reference = simulate(arm, o);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  o = options(t_end, t_end, rtol, 1e-9);
+  o.integrator.method = IntegratorMethod::kAuto;
+  const TransientRun run = simulate(arm, o);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double e = run_error(arm, run, reference);
+  ASSERT_EQ(run.result.phases.size(), 2u);
+  const MethodPhase& last = run.result.phases.back();
+  std::printf(
+      "rod of 40 segments on a spherical joint, auto, rtol 1e-6: %.2e rtol, %ld steps, "
+      "dirk from t = %.5f s: %s\n",
+      e / rtol, run.result.stats.steps, last.t, last.reason.c_str());
+  EXPECT_EQ(last.method, "dirk") << last.reason;
+  EXPECT_NE(last.reason.find("stiff modes' ringing held short (8263 of its last"),
+            std::string::npos)
+      << last.reason;
+  EXPECT_GT(last.t, 0.01);
+  EXPECT_LT(last.t, 0.0102);
+  EXPECT_LT(run.result.stats.steps, 45000);
+  EXPECT_LT(e, rtol);
+}
+
 // A damped grounded mechanism (a body not held by beams, no floating part) runs dirk. Along a
 // mechanism's large motion the relinearized modal phases' error can grow past their estimates (a
 // pendulum on a revolute joint, 1 s: 38 rtol at rtol 1e-4 over 131 phases, an adversarial review

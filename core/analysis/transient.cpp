@@ -391,6 +391,17 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     };
     double arm = 0.0;  // the longest centre -> attachment arm of an element [m]
     double last_length = 0.0, last_angle = 0.0;  // the smallest margins at the last step
+    // Whether they are: a step whose method bounds its own path (the modal method) leaves them
+    // to be found at last_y when a step that does not follows (auto's hand-over).
+    bool last_margins = true;
+    const auto smallest_margins = [&](const double* y_at, double t_at, double* length,
+                                      double* angle) {
+      set_state(model, watched, y_at);
+      set_driven_poses(model, watched, t_at);
+      const ElementMargins m = element_margins(model, watched);
+      *length = *std::min_element(m.length.begin(), m.length.end());
+      *angle = *std::min_element(m.angle.begin(), m.angle.end());
+    };
     {
       set_state(model, watched, y.data());
       set_driven_poses(model, watched, 0.0);
@@ -411,12 +422,12 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
       // CVODE shows the same state at each attempt of a step: looked at once.
       const bool elements = !(model.beams.empty() && model.rails.empty()) && t_step > last_t;
       double end_length = last_length, end_angle = last_angle;  // the smallest margins here
-      if (elements) {
-        set_state(model, watched, y_step);
-        set_driven_poses(model, watched, t_step);
-        const ElementMargins end = element_margins(model, watched);
-        end_length = *std::min_element(end.length.begin(), end.length.end());
-        end_angle = *std::min_element(end.angle.begin(), end.angle.end());
+      if (elements && !context.path_bounded) {
+        if (!last_margins) {
+          smallest_margins(last_y.data(), last_t, &last_length, &last_angle);
+          last_margins = true;
+        }
+        smallest_margins(y_step, t_step, &end_length, &end_angle);
       }
       if (t_step > last_t && context.divergence.empty() && !context.path_bounded && elements) {
         const double h = t_step - last_t;
@@ -506,6 +517,7 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
         last_t = t_step;
         last_length = end_length;
         last_angle = end_angle;
+        if (elements) last_margins = !context.path_bounded;
       }
       set_state(model, watched, y_step);
       set_driven_poses(model, watched, t_step);

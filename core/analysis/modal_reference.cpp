@@ -70,10 +70,13 @@ bool modal_reference(const Model& model, const IntegratorOptions& options, OdeCo
                                "about the initial state");
     initial->because = why;
     initial->no_equilibrium = !equilibrium.ok && equilibrium.no_equilibrium;
+    // auto (max_rotation set) relinearizes where a body turns its limit; modal alone stops.
+    const std::string then =
+        options.max_rotation > 0.0
+            ? " (auto linearizes again as the bodies turn)"
+            : " (the run stops if a body turns more than " + rotation_limit_text() + " from there)";
     warnings.push_back("the modal integrator linearized about the initial state: " + why +
-                       (equilibrium.ok ? " (the run stops if a body turns more than " +
-                                             rotation_limit_text() + " from there)"
-                                       : ""));
+                       (equilibrium.ok ? then : ""));
     return true;
   }
   for (int b = 0; b < model.n_free(); ++b) {

@@ -299,6 +299,18 @@ TEST(ModalIntegrator, DoesNotLinearizeAboutAFarEquilibrium) {
                                         "equilibrium under the loads at t = 0, body \"tip\""),
             std::string::npos)
       << run.result.warnings[0];
+  EXPECT_NE(run.result.warnings[0].find("the run stops if a body turns more than 1 rad"),
+            std::string::npos)
+      << run.result.warnings[0];
+  // auto linearizes again as the bodies turn: its run does not stop there, and says so.
+  o.integrator.method = IntegratorMethod::kAuto;
+  const TransientRun relinearized = simulate(model, o);
+  ASSERT_TRUE(relinearized.result.ok) << relinearized.result.message;
+  ASSERT_FALSE(relinearized.result.warnings.empty());
+  EXPECT_NE(relinearized.result.warnings[0].find("(auto linearizes again as the bodies turn)"),
+            std::string::npos)
+      << relinearized.result.warnings[0];
+  EXPECT_EQ(relinearized.result.warnings[0].find("the run stops"), std::string::npos);
 }
 
 TEST(ModalIntegrator, RestartsAtLoadBreakpoints) {

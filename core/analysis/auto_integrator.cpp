@@ -180,14 +180,12 @@ class AutoIntegrator : public Integrator {
       }
       if (flag == kModalHeld && modal_) {
         const HeldSteps stretch = modal_held_steps(*current_);
-        const long steps = current_->stats().steps;
         before_ = sum(before_, current_->stats());
         std::string error;
         if (!start_method(IntegratorMethod::kDirk, "", *t, y,
                           "a mechanism whose modal steps its stiff modes' ringing held short (" +
                               std::to_string(stretch.held) + " of its last " +
-                              std::to_string(stretch.steps) + " steps, of " +
-                              std::to_string(steps) + ", at less than " +
+                              std::to_string(stretch.steps) + " steps at less than " +
                               number(kMechanismHeldShare) +
                               " of the step its estimates asked for): dirk steps over that "
                               "ringing",
@@ -249,6 +247,7 @@ class AutoIntegrator : public Integrator {
         continue;
       }
       if (modal_mechanism_bound(*current_)) hold_modal_mechanism_bound(*next);
+      continue_modal_held_steps(*current_, *next);
       next->restart(*t, y);
       band_hz = std::max(band_hz, next->band_hz);
       absorb_inertia();

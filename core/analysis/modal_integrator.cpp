@@ -883,6 +883,7 @@ class ModalExponential : public Integrator {
   // advance() stops (kHeld) after the step at which the held steps of the latest stretch reach
   // `held` (0: never).
   void set_held_limit(long held) { held_limit_ = held; }
+  void continue_held_steps(const HeldSteps& stretch) { held_ = stretch; }
 
   // Whether the band's slowest elastic mode has turned kInertiaSettling rad since the run began.
   // Before, a load that starts from rest gives a ratio of kinetic energies far above the
@@ -1050,6 +1051,12 @@ bool set_modal_held_limit(Integrator& integrator, long held) {
   if (!modal) return false;
   modal->set_held_limit(held);
   return true;
+}
+
+void continue_modal_held_steps(const Integrator& from, Integrator& to) {
+  const auto* previous = dynamic_cast<const ModalExponential*>(&from);
+  auto* next = dynamic_cast<ModalExponential*>(&to);
+  if (previous && next) next->continue_held_steps(previous->held_steps());
 }
 
 bool modal_mechanism_bound(const Integrator& integrator) {

@@ -154,6 +154,9 @@ HeldSteps modal_held_steps(const Integrator& integrator);
 // stretch reach `held` (0: never, the default); false when `integrator` is not a modal
 // integrator.
 bool set_modal_held_limit(Integrator& integrator, long held);
+// Continues `from`'s latest stretch of held steps in `to` (a phase relinearized from it): a
+// mechanism relinearized every few thousand steps counts its held steps across its phases.
+void continue_modal_held_steps(const Integrator& from, Integrator& to);
 
 // Whether a modal integrator's mechanism step bound (kMechanismStep) holds at its accepted state:
 // a mechanism whose stiff modes hold energy.

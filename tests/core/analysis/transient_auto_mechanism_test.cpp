@@ -426,6 +426,50 @@ TEST(TransientAuto, HeldStepsCountFromWhereTheHoldBegins) {
   EXPECT_LT(e, rtol);
 }
 
+// A relinearized phase continues the stretch of held steps of the phase before it
+// (continue_modal_held_steps): the rod above in 8 segments (54 degrees of freedom, so 171,468
+// held steps make the work) at rtol 1e-4 relinearized every 0.01 to 0.02 s, fewer held steps in
+// each phase than that, and never went on with dirk: 0.3 s took 2.5 million modal steps in 50 s
+// (dirk alone 1.6 s; an adversarial review). Now dirk goes on from 0.026 s, 181,410 steps, 5 s.
+TEST(TransientAuto, HeldStepsCountAcrossRelinearizations) {
+  const Model arm = scene_from_json(R"({
+    "gravity": [0, -9.81, 0],
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "hub", "mass": 0.1, "inertia": [1e-4, 1e-4, 1e-4], "position": [0, 0, 0]},
+               {"name": "tip", "mass": 0.5, "inertia": [1e-4, 1e-4, 1e-4], "position": [0.5, 0, 0],
+                "velocity": [0, 0, 1]}],
+    "beams": [{"name": "arm", "body1": "hub", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [0.5, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
+               "segments": 8}],
+    "joints": [{"name": "s", "type": "spherical", "body1": "ground", "body2": "hub",
+                "point": [0, 0, 0]}]})");
+  const double t_end = 0.03, rtol = 1e-4;
+  TransientOptions o = options(t_end, t_end, 1e-8, 1e-11);
+  o.integrator.method = IntegratorMethod::kDirk;
+  const TransientRun reference = simulate(arm, o);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  o = options(t_end, t_end, rtol, 1e-9);  // the default atol
+  o.integrator.method = IntegratorMethod::kAuto;
+  const TransientRun run = simulate(arm, o);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const double e = run_error(arm, run, reference);
+  std::printf("rod of 8 segments on a spherical joint, auto, rtol 1e-4: %.2e rtol, %ld steps\n",
+              e / rtol, run.result.stats.steps);
+  ASSERT_EQ(run.result.phases.size(), 3u);
+  EXPECT_EQ(run.result.phases[0].method, "modal");
+  EXPECT_EQ(run.result.phases[1].method, "modal");
+  EXPECT_NE(run.result.phases[1].reason.find("relinearized"), std::string::npos)
+      << run.result.phases[1].reason;
+  const MethodPhase& last = run.result.phases.back();
+  EXPECT_EQ(last.method, "dirk") << last.reason;
+  EXPECT_NE(last.reason.find("held short (171468 of its last"), std::string::npos) << last.reason;
+  // The stretch began before the relinearization: the second phase alone holds fewer.
+  EXPECT_LT(last.t, 0.027);
+  EXPECT_LT(run.result.stats.steps, 200000);
+  EXPECT_LT(e, rtol);
+}
+
 // A damped grounded mechanism (a body not held by beams, no floating part) runs dirk. Along a
 // mechanism's large motion the relinearized modal phases' error can grow past their estimates (a
 // pendulum on a revolute joint, 1 s: 38 rtol at rtol 1e-4 over 131 phases, an adversarial review

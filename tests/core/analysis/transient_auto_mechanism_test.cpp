@@ -27,6 +27,27 @@ using testing::simulate;
 using testing::tight;
 using testing::TransientRun;
 
+// A 0.5 m steel rod of 10 mm square section in `segments` segments with a 0.5 kg tip, on a joint
+// to the ground through a 0.1 kg hub at the origin (`joint`: its type and axis, JSON), under
+// gravity; the tip starts at `tip_velocity` (JSON).
+Model rod_on_joint(const std::string& joint, int segments,
+                   const std::string& tip_velocity = "[0, 0, 0]") {
+  return scene_from_json(R"({
+    "gravity": [0, -9.81, 0],
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "hub", "mass": 0.1, "inertia": [1e-4, 1e-4, 1e-4], "position": [0, 0, 0]},
+               {"name": "tip", "mass": 0.5, "inertia": [1e-4, 1e-4, 1e-4], "position": [0.5, 0, 0],
+                "velocity": )" +
+                         tip_velocity + R"(}],
+    "beams": [{"name": "arm", "body1": "hub", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [0.5, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
+               "segments": )" +
+                         std::to_string(segments) + R"(}],
+    "joints": [{"name": "h", "body1": "ground", "body2": "hub", "point": [0, 0, 0], )" +
+                         joint + "}]}");
+}
+
 // An arm on a revolute joint to the ground (relative compliance `compliance`) and a bob on a rod
 // (`damping`: its damping coefficient, 0: none), swinging at 4 rad/s under gravity; with
 // `compliance` 0, the arm and the bob alone, floating (no joint, no gravity).
@@ -342,20 +363,12 @@ TEST(TransientAuto, AMechanismWhoseModalStepsResolveItsFastestModeGoesOnWithErk)
 // 10 mm in 40 segments with a 0.5 kg tip, on a revolute joint through a 0.1 kg hub, released level
 // under gravity. From 0.02 s on its joint's and segments' stiff modes held every modal step about
 // a hundred times shorter than the estimates' step: 33,690 steps for 0.05 s (5.1 s) before, 1.5e-9
-// of the motion off a dirk run at rtol 1e-10; with the hand-over at 0.04 s 15,266 (2.3 s), as
-// close. Over 0.3 s in 100 segments: 536,232 steps in 414 s before, 43,146 in 41 s now.
+// of the motion off a dirk run at rtol 1e-10; with the hand-over at 0.037 s 10,326 (held below a
+// tenth of the estimates' step: HeldStepsCountFromWhereTheHoldBegins; at 0.04 s 15,266 before), as
+// close. Over 0.3 s in 100 segments: 536,232 steps in 414 s before, 43,146 in 41 s with the
+// hand-over at a thirtieth.
 TEST(TransientAuto, AMechanismHeldByItsStiffModesRingingGoesOnWithDirk) {
-  const Model arm = scene_from_json(R"({
-    "gravity": [0, -9.81, 0],
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "hub", "mass": 0.1, "inertia": [1e-4, 1e-4, 1e-4], "position": [0, 0, 0]},
-               {"name": "tip", "mass": 0.5, "inertia": [1e-4, 1e-4, 1e-4], "position": [0.5, 0, 0]}],
-    "beams": [{"name": "arm", "body1": "hub", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [0.5, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
-               "segments": 40}],
-    "joints": [{"name": "h", "type": "revolute", "body1": "ground", "body2": "hub",
-                "point": [0, 0, 0], "axis": [0, 0, 1]}]})");
+  const Model arm = rod_on_joint(R"("type": "revolute", "axis": [0, 0, 1])", 40);
   const double t_end = 0.05, rtol = 1e-6;
   TransientOptions o = options(t_end, 0.001, 1e-8, 1e-11);
   o.integrator.method = IntegratorMethod::kDirk;
@@ -388,18 +401,7 @@ TEST(TransientAuto, AMechanismHeldByItsStiffModesRingingGoesOnWithDirk) {
 // 1/30 of the estimates' step, at each 5 ms output, it was never handed over: 0.02 s took 695,378
 // steps, 98 s (dirk alone 18 s); now dirk goes on after 8,263 held steps (kAutoHeldWork).
 TEST(TransientAuto, HeldStepsCountFromWhereTheHoldBegins) {
-  const Model arm = scene_from_json(R"({
-    "gravity": [0, -9.81, 0],
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "hub", "mass": 0.1, "inertia": [1e-4, 1e-4, 1e-4], "position": [0, 0, 0]},
-               {"name": "tip", "mass": 0.5, "inertia": [1e-4, 1e-4, 1e-4], "position": [0.5, 0, 0],
-                "velocity": [0, 0, 1]}],
-    "beams": [{"name": "arm", "body1": "hub", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [0.5, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
-               "segments": 40}],
-    "joints": [{"name": "s", "type": "spherical", "body1": "ground", "body2": "hub",
-                "point": [0, 0, 0]}]})");
+  const Model arm = rod_on_joint(R"("type": "spherical")", 40, "[0, 0, 1]");
   const double t_end = 0.0105, rtol = 1e-6;
   TransientOptions o = options(t_end, t_end, 1e-7, 1e-10);
   o.integrator.method = IntegratorMethod::kDirk;
@@ -432,18 +434,7 @@ TEST(TransientAuto, HeldStepsCountFromWhereTheHoldBegins) {
 // each phase than that, and never went on with dirk: 0.3 s took 2.5 million modal steps in 50 s
 // (dirk alone 1.6 s; an adversarial review). Now dirk goes on from 0.026 s, 181,410 steps, 5 s.
 TEST(TransientAuto, HeldStepsCountAcrossRelinearizations) {
-  const Model arm = scene_from_json(R"({
-    "gravity": [0, -9.81, 0],
-    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
-    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
-    "bodies": [{"name": "hub", "mass": 0.1, "inertia": [1e-4, 1e-4, 1e-4], "position": [0, 0, 0]},
-               {"name": "tip", "mass": 0.5, "inertia": [1e-4, 1e-4, 1e-4], "position": [0.5, 0, 0],
-                "velocity": [0, 0, 1]}],
-    "beams": [{"name": "arm", "body1": "hub", "body2": "tip", "point1": [0, 0, 0],
-               "point2": [0.5, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
-               "segments": 8}],
-    "joints": [{"name": "s", "type": "spherical", "body1": "ground", "body2": "hub",
-                "point": [0, 0, 0]}]})");
+  const Model arm = rod_on_joint(R"("type": "spherical")", 8, "[0, 0, 1]");
   const double t_end = 0.03, rtol = 1e-4;
   TransientOptions o = options(t_end, t_end, 1e-8, 1e-11);
   o.integrator.method = IntegratorMethod::kDirk;

@@ -48,6 +48,15 @@ Model rod_on_joint(const std::string& joint, int segments,
                          joint + "}]}");
 }
 
+// A run of `method` over [0, t_end], outputs every `output_step`, at rtol and atol.
+TransientRun run_of(const Model& model, IntegratorMethod method, double t_end, double output_step,
+                    double rtol, double atol, const std::string& about = "") {
+  TransientOptions o = options(t_end, output_step, rtol, atol);
+  o.integrator.method = method;
+  o.integrator.about = about;
+  return simulate(model, o);
+}
+
 // An arm on a revolute joint to the ground (relative compliance `compliance`) and a bob on a rod
 // (`damping`: its damping coefficient, 0: none), swinging at 4 rad/s under gravity; with
 // `compliance` 0, the arm and the bob alone, floating (no joint, no gravity).
@@ -370,14 +379,11 @@ TEST(TransientAuto, AMechanismWhoseModalStepsResolveItsFastestModeGoesOnWithErk)
 TEST(TransientAuto, AMechanismHeldByItsStiffModesRingingGoesOnWithDirk) {
   const Model arm = rod_on_joint(R"("type": "revolute", "axis": [0, 0, 1])", 40);
   const double t_end = 0.05, rtol = 1e-6;
-  TransientOptions o = options(t_end, 0.001, 1e-8, 1e-11);
-  o.integrator.method = IntegratorMethod::kDirk;
-  const TransientRun reference = simulate(arm, o);  // 1.5e-11 of the motion off rtol 1e-10's
+  // 1.5e-11 of the motion off rtol 1e-10's:
+  const TransientRun reference = run_of(arm, IntegratorMethod::kDirk, t_end, 0.001, 1e-8, 1e-11);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
-  o = options(t_end, 0.001, rtol, 1e-9);
-  o.integrator.method = IntegratorMethod::kAuto;
-  o.integrator.about = "initial";
-  const TransientRun run = simulate(arm, o);
+  const TransientRun run =
+      run_of(arm, IntegratorMethod::kAuto, t_end, 0.001, rtol, 1e-9, "initial");
   ASSERT_TRUE(run.result.ok) << run.result.message;
   const double e = run_error(arm, run, reference);
   ASSERT_EQ(run.result.phases.size(), 2u);
@@ -403,13 +409,9 @@ TEST(TransientAuto, AMechanismHeldByItsStiffModesRingingGoesOnWithDirk) {
 TEST(TransientAuto, HeldStepsCountFromWhereTheHoldBegins) {
   const Model arm = rod_on_joint(R"("type": "spherical")", 40, "[0, 0, 1]");
   const double t_end = 0.0105, rtol = 1e-6;
-  TransientOptions o = options(t_end, t_end, 1e-7, 1e-10);
-  o.integrator.method = IntegratorMethod::kDirk;
-  const TransientRun reference = simulate(arm, o);
+  const TransientRun reference = run_of(arm, IntegratorMethod::kDirk, t_end, t_end, 1e-7, 1e-10);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
-  o = options(t_end, t_end, rtol, 1e-9);
-  o.integrator.method = IntegratorMethod::kAuto;
-  const TransientRun run = simulate(arm, o);
+  const TransientRun run = run_of(arm, IntegratorMethod::kAuto, t_end, t_end, rtol, 1e-9);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   const double e = run_error(arm, run, reference);
   ASSERT_EQ(run.result.phases.size(), 2u);
@@ -436,13 +438,10 @@ TEST(TransientAuto, HeldStepsCountFromWhereTheHoldBegins) {
 TEST(TransientAuto, HeldStepsCountAcrossRelinearizations) {
   const Model arm = rod_on_joint(R"("type": "spherical")", 8, "[0, 0, 1]");
   const double t_end = 0.03, rtol = 1e-4;
-  TransientOptions o = options(t_end, t_end, 1e-8, 1e-11);
-  o.integrator.method = IntegratorMethod::kDirk;
-  const TransientRun reference = simulate(arm, o);
+  const TransientRun reference = run_of(arm, IntegratorMethod::kDirk, t_end, t_end, 1e-8, 1e-11);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
-  o = options(t_end, t_end, rtol, 1e-9);  // the default atol
-  o.integrator.method = IntegratorMethod::kAuto;
-  const TransientRun run = simulate(arm, o);
+  // atol 1e-9, the default:
+  const TransientRun run = run_of(arm, IntegratorMethod::kAuto, t_end, t_end, rtol, 1e-9);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   const double e = run_error(arm, run, reference);
   std::printf("rod of 8 segments on a spherical joint, auto, rtol 1e-4: %.2e rtol, %ld steps\n",

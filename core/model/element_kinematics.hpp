@@ -95,14 +95,15 @@ struct ElementFrames {
 template <class T>
 void relative_angles(const Mat3T<T>& a, bool twist_free, Vec3T<T>& phi, Mat3T<T>& t) {
   using std::atan2;
-  phi << atan2(a(2, 1), a(1, 1)), atan2(a(0, 2), a(2, 2)), atan2(a(1, 0), a(0, 0));
+  phi(0) = atan2(a(2, 1), a(1, 1));
+  phi(1) = twist_free ? atan2(-a(2, 0), a(0, 0)) : atan2(a(0, 2), a(2, 2));
+  phi(2) = atan2(a(1, 0), a(0, 0));
   const T nx = a(1, 1) * a(1, 1) + a(2, 1) * a(2, 1);
   const T nz = a(0, 0) * a(0, 0) + a(1, 0) * a(1, 0);
   t(0, 0) = T(1), t(0, 1) = -a(0, 1) * a(1, 1) / nx, t(0, 2) = -a(0, 1) * a(2, 1) / nx;
   t(2, 0) = -a(0, 0) * a(2, 0) / nz, t(2, 1) = -a(1, 0) * a(2, 0) / nz, t(2, 2) = T(1);
   if (twist_free) {
     const T n = a(0, 0) * a(0, 0) + a(2, 0) * a(2, 0);
-    phi(1) = atan2(-a(2, 0), a(0, 0));
     t(1, 0) = -a(0, 0) * a(1, 0) / n, t(1, 1) = T(1), t(1, 2) = -a(1, 0) * a(2, 0) / n;
   } else {
     const T ny = a(0, 2) * a(0, 2) + a(2, 2) * a(2, 2);

@@ -192,6 +192,11 @@ class ModalExponential : public Integrator {
   // turned too far.
   bool nonlinear(double t, const Block& z, Block& x, Block& out, int* flag);
 
+  // nonlinear() at the accepted state (t_, z_, x_) into n0_; where it fails (or throws) x_ is
+  // what it was before: the iteration's diverged quasi-static part is not the state a method
+  // going on from here starts from, nor the state reported.
+  bool nonlinear_at_accepted(int* flag);
+
   // The accelerations at the physical state x and M0 a into m0_v_, for a projection that
   // finishes N (every mode integrated: N = Phi^T M0 a + lambda z, project_then). False when the
   // forces are not finite or a body turned too far.
@@ -333,6 +338,7 @@ class ModalExponential : public Integrator {
   double damping_coupling_ = 0.0;  // modal_damping: the damping left in N, per mode velocity
   ModalCoordinates coordinates_;   // the bodies' offsets from the linearization and back
   Block z_, x_;                    // the accepted state, modal and physical (x_ = Phi z_)
+  Block accepted_x_;               // work space of nonlinear_at_accepted
   Block xi_, x_next_;              // work space: a stage's physical state, a trial step's
   // A trial step's new state and its two error estimates side by side, modal and physical.
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;

@@ -21,7 +21,7 @@ int ModalExponential::advance(double tout, double tstop, N_Vector y, double* t) 
   if ((flag == kOk || flag == kInertia || flag == kHeld) && reduced_ && !have_n0_) {
     try {
       const int reached = flag;
-      if (!nonlinear(t_, z_, x_, n0_, &flag)) flag = fail_flag(flag);
+      if (!nonlinear_at_accepted(&flag)) flag = fail_flag(flag);
       have_n0_ = flag == kOk;
       if (have_n0_) {
         flag = reached;
@@ -230,6 +230,19 @@ bool ModalExponential::nonlinear(double t, const Block& z, Block& x, Block& out,
   return true;
 }
 
+bool ModalExponential::nonlinear_at_accepted(int* flag) {
+  accepted_x_ = x_;
+  bool ok = false;
+  try {
+    ok = nonlinear(t_, z_, x_, n0_, flag);
+  } catch (...) {
+    x_.swap(accepted_x_);
+    throw;
+  }
+  if (!ok) x_.swap(accepted_x_);
+  return ok;
+}
+
 bool ModalExponential::evaluate(double t, const Block& x, int* flag) {
   if (!states_of(t, x, y13_.data())) {
     *flag = kTooFar;
@@ -358,7 +371,7 @@ int ModalExponential::step_towards(double target) {
     if (!have_n0_) {
       // Band-limited, N at the accepted state now; else its accelerations, projected in the
       // step's first pass.
-      if (reduced_ ? !nonlinear(t_, z_, x_, n0_, &flag) : !evaluate(t_, x_, &flag))
+      if (reduced_ ? !nonlinear_at_accepted(&flag) : !evaluate(t_, x_, &flag))
         return fail_flag(flag);
       have_n0_ = reduced_;
     }

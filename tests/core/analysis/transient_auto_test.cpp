@@ -407,6 +407,54 @@ TEST(TransientAuto, AFailedModalPhaseGoesOnWithTheImplicitMethod) {
       }));
 }
 
+// Where a band's quasi-static iteration fails at the accepted state itself (here at the start),
+// the modal method reports the state it had accepted, not the iteration's diverged one
+// (nonlinear_at_accepted, core/analysis/modal_exponential.hpp). A 0.5 kg tip on a 1 m cantilever
+// of 10 mm square steel in 40 segments under a 20 N step, in a band of 30 Hz given (an adversarial
+// review, 2026-12-03): auto's dirk went on at t = 0 from that diverged state, the tip moving up
+// against the load with 4.0 J the scene never had, and ran out of its 60 s at 0.124 s of 0.5 s,
+// 1.5e4 rtol off at rtol 1e-6 (171 rtol at 1e-4 by 0.29 s). Now its first output agrees with
+// dirk's alone, and the run 1.6e-4 / 1.4e-5 rtol (rtol 1e-6 / 1e-4) over 0.5 s in 20.6 / 5.3 s.
+// Here (0.02 s, rtol 1e-4) before: the tip 0.87 mm up at 2 ms, 6,380 rtol off; now 6.5e-4.
+TEST(TransientAuto, AModalPhaseFailedAtItsStartHandsOverTheStateItAccepted) {
+  const Model model = scene_from_json(R"({
+    "materials": {"steel": {"E": 2.1e11, "G": 8.0769e10, "density": 7850}},
+    "sections": {"sq10": {"shape": "rectangle", "width": 0.01, "height": 0.01}},
+    "bodies": [{"name": "tip", "mass": 0.5, "inertia": [1e-5, 1e-5, 1e-5], "position": [1, 0, 0]}],
+    "beams": [{"name": "arm", "body1": "ground", "body2": "tip", "point1": [0, 0, 0],
+               "point2": [1, 0, 0], "point3": [0, 1, 0], "material": "steel", "section": "sq10",
+               "segments": 40}],
+    "loads": [{"type": "force", "body": "tip", "value": [0, -20, 0],
+               "time": {"type": "step", "at": 0.0}}]})");
+  const double t_end = 0.02, output_step = 2e-3, rtol = 1e-4;
+  TransientOptions o = options(t_end, output_step, 1e-9, 1e-12);
+  o.integrator.method = IntegratorMethod::kDirk;
+  const TransientRun reference = simulate(model, o);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  o = options(t_end, output_step, rtol, 1e-3 * rtol);
+  o.integrator.method = IntegratorMethod::kAuto;
+  o.integrator.max_frequency_hz = 30.0;
+  const TransientRun run = simulate(model, o);
+  ASSERT_TRUE(run.result.ok) << run.result.message;
+  const std::vector<MethodPhase>& phases = run.result.phases;
+  ASSERT_EQ(phases.size(), 2u);
+  EXPECT_EQ(phases[1].method, std::string("dirk ") + kAutoImplicitTable);
+  EXPECT_EQ(phases[1].t, 0.0);
+  EXPECT_NE(phases[1].reason.find("the modal method failed ("), std::string::npos)
+      << phases[1].reason;
+  // The tip at the first output: pulled down by the load, as dirk's alone.
+  size_t tip = 0;
+  while (tip < model.bodies.size() && model.bodies[tip].name != "tip") ++tip;
+  ASSERT_LT(tip, model.bodies.size());
+  const double y_run = run.samples[1].c[tip](1), y_reference = reference.samples[1].c[tip](1);
+  const double e = run_error(model, run, reference);
+  std::printf("tip at t = %.3g s: %.6e m (dirk alone %.6e m); %ld steps, %.3g rtol off\n",
+              run.samples[1].sample.t, y_run, y_reference, run.result.stats.steps, e / rtol);
+  EXPECT_LT(y_run, 0.0);
+  EXPECT_NEAR(y_run, y_reference, 1e-3 * std::abs(y_reference));
+  EXPECT_LT(e, rtol);
+}
+
 // Beyond the dense solver's size the band comes from Lanczos: measured against a run of another
 // method, the default DIRK table at a fixed step (L-stable: it damps the modes its step cannot
 // resolve), whose own error is measured by halving that step.

@@ -122,9 +122,11 @@ class AutoIntegrator : public Integrator {
     // equilibrium exists, and the initial state is auto's choice, not a fallback: the reason
     // says so, without the modal method's warning.
     const InitialLinearization initial = modal_initial_linearization(*modal);
+    first_modal_warnings_ = warnings.size();
     for (const std::string& w : modal->warnings)
       if (!initial.no_equilibrium || w.find(initial.because) == std::string::npos)
         warnings.push_back(w);
+    first_modal_warnings_end_ = warnings.size();
     const std::string& initial_because = initial.because;
     const bool about_initial = o.about == "initial" || !initial_because.empty();
     band_hz = modal->band_hz;
@@ -167,6 +169,11 @@ class AutoIntegrator : public Integrator {
             return kAutoFailed;
           continue;
         }
+        // A first modal phase that failed before its first step left nothing of its model in
+        // the run: what its set-up warned of (its band, its linearization) does not apply.
+        if (count_ == 1 && current_->stats().steps == 0)
+          warnings.erase(warnings.begin() + static_cast<long>(first_modal_warnings_),
+                         warnings.begin() + static_cast<long>(first_modal_warnings_end_));
         before_ = sum(before_, current_->stats());
         std::string error;
         if (!start_method(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
@@ -478,6 +485,8 @@ class AutoIntegrator : public Integrator {
   SolverStats before_;                                   // of the phases before the current one
   QuasiStaticInertia inertia_;  // the dropped inertia of the modal phases before the current one
   std::string failure_;         // why auto itself failed (kAutoFailed)
+  // The warnings of the first modal phase's set-up: [first_modal_warnings_, .._end_).
+  size_t first_modal_warnings_ = 0, first_modal_warnings_end_ = 0;
   std::vector<MethodPhase> first_;
   MethodPhase last_;
   long count_ = 0;

@@ -346,7 +346,8 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     }
     integrator->phase_started = options.phase_started;
     result.linear_solver = integrator->linear_solver;
-    result.warnings = integrator->warnings;
+    const std::vector<std::string> set_up_warnings = integrator->warnings;
+    result.warnings = set_up_warnings;
     if (harmonic_step > 0.0 && io.fixed_step > harmonic_step) {
       char text[400];
       std::snprintf(text, sizeof text,
@@ -608,6 +609,12 @@ TransientResult run_transient(const Model& model, const TransientOptions& option
     for (const std::string& w : integrator->warnings)  // auto's arrive during the run
       if (std::find(result.warnings.begin(), result.warnings.end(), w) == result.warnings.end())
         result.warnings.push_back(w);
+    // and auto withdraws those of a first modal phase that failed before its first step.
+    const std::vector<std::string>& kept = integrator->warnings;
+    for (const std::string& w : set_up_warnings)
+      if (std::find(kept.begin(), kept.end(), w) == kept.end())
+        result.warnings.erase(std::remove(result.warnings.begin(), result.warnings.end(), w),
+                              result.warnings.end());
     for (std::string& w : integrator->closing_warnings()) result.warnings.push_back(std::move(w));
     result.axial_force_effect = axial.largest();
     result.axial_force_time = axial.when();

@@ -107,7 +107,7 @@ class AutoIntegrator : public Integrator {
     if (double own = 0.0, coupling = 0.0; modal_damping(*modal, &own, &coupling) && own > 0.0) {
       // Each mode's own damping is exact in its block; what couples the modes stays explicit.
       if (const std::string why = coupled_damping(*modal); !why.empty())
-        return start_method(IntegratorMethod::kBdf, "", 0.0, y0, why, error);
+        return start_method(IntegratorMethod::kDirk, "", 0.0, y0, why, error);
       const double step = coupling > 0.0 ? 2.5 / coupling : 0.0;
       reason += "; each mode's damping exact (up to " + number(own) + " 1/s)";
       if (step > 0.0)
@@ -250,7 +250,7 @@ class AutoIntegrator : public Integrator {
       if (const std::string coupled = coupled_damping(*next); !coupled.empty()) {
         // Relinearized where damping couples the modes more (a deformed structure).
         std::string error;
-        if (!start_method(IntegratorMethod::kBdf, "", *t, y, coupled, &error)) return fail(error);
+        if (!start_method(IntegratorMethod::kDirk, "", *t, y, coupled, &error)) return fail(error);
         continue;
       }
       if (modal_mechanism_bound(*current_)) hold_modal_mechanism_bound(*next);
@@ -317,7 +317,7 @@ class AutoIntegrator : public Integrator {
     return "damping that couples the modes (" + number(coupling) + " 1/s, " + number(ratio) +
            " of the fastest mode's critical damping; the modes' own is exact) would hold the "
            "modal method's steps below " +
-           number(2.5 / coupling) + " s; bdf steps over the decayed modes";
+           number(2.5 / coupling) + " s; dirk (L-stable) steps over the decayed modes";
   }
 
   // Why an explicit Runge-Kutta method goes on from t, when the modal phase that ended there

@@ -4,7 +4,7 @@
 //   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless
 //   damping that couples its modes damps beyond kAutoMaxDampingRatio of the fastest mode's
 //   critical damping (each mode's own damping is exact in the modal method, the coupling
-//   explicit): then bdf, as before auto. From kAutoChosenBandDofs on, the modal method's band is
+//   explicit): then dirk (the default table). From kAutoChosenBandDofs on, the modal method's band is
 //   chosen for rtol (core/analysis/modal_band.hpp); when no band of the modes it may ask for
 //   meets rtol, every mode up to kModalIntegratorMaxDofs, else bdf.
 // - When a body turns more than kAutoRelinearizeRotation (less after cheap relinearizations,
@@ -57,13 +57,20 @@ inline constexpr const char* kAutoImplicitTable = "ESDIRK547L2SA2_7_4_5";
 // core/analysis/modal_integrator.hpp) and the damping that couples the modes (members damped
 // differently) explicitly, so that coupling d [1/s] holds its steps below about 2.5 / d; an
 // L-stable implicit method steps over the damped fast modes once they have decayed. auto takes
-// bdf when d / (2 w_max) exceeds this. Measured while all damping was explicit (scripts in the
+// dirk (the default table) when d / (2 w_max) exceeds this, at the start or where a
+// relinearization finds it so. Measured while all damping was explicit (scripts in the
 // commit message of 2026-11): on the reference cantilever in 10 segments at rtol 1e-6,
 // modal/bdf wall 0.16 at a ratio of 0.01, 0.41 at 0.05, 2.6 at 0.21, 9.3 at 0.83. With each
 // mode's own damping exact, one `damping` for every member keeps the modal method at any
 // strength: there bdf was 8 to 161 rtol off on the lightly damped cantilevers of an adversarial
 // review (2026-11-29), the modal method within 1 rtol (docs/transient_measurements.md "Damped modes
-// exact").
+// exact"). Until 2026-12-03 that method was bdf, which an adversarial review found slower and
+// off where members are damped differently or a relinearized phase damps more (docs/
+// transient_measurements.md "Damping that couples the modes goes on with dirk"): a portal frame
+// with one column undamped, rtol 1e-4 / 1e-6 (against dirk at rtol 1e-10, in rtol): bdf 52,693 /
+// 55,138 steps, 2.76 / 2.82 s, 0.0016 / 0.014; dirk 994 / 3,241 steps, 0.36 / 1.03 s, 0.0033 /
+// 0.018. A damped cantilever bending 30 % under its tip load, handed over at 0.098 s: bdf from
+// there 2.0 / 2.6 rtol off; bdf alone 6.8 / 45, dirk alone 0.0011 / 0.00035.
 inline constexpr double kAutoMaxDampingRatio = 0.1;
 
 // A modal phase (every mode integrated) that moved a mechanism (a body not held by beams and

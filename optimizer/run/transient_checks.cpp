@@ -119,8 +119,8 @@ bool may_verify_after_the_run(const AnalysisSpec& spec, const TransientOptions& 
 }
 
 // Why a transient is verified after its run, "" when it is not: by default ("auto") an auto run
-// - that handed a phase to bdf (damping that couples the modes, a modal method that could not
-//   start), for the reason verification_reason verifies bdf by name;
+// - that handed a phase to bdf (a modal method that could not start), for the reason
+//   verification_reason verifies bdf by name;
 // - or that relinearized as a body turned its limit. Its motion is then not a small one about a
 // configuration, where the modal method's error estimates were measured to hold; along large
 // motions the error can grow far past rtol with no other sign: an L-frame (a 1 m steel

@@ -197,6 +197,10 @@ class ModalExponential : public Integrator {
   // going on from here starts from, nor the state reported.
   bool nonlinear_at_accepted(int* flag);
 
+  // Whether the quasi-static part's change over the step just accepted stands above the
+  // iteration's noise (kQuasiStaticNoiseMargin): its kinetic energy then counts.
+  bool quasi_step_resolved() const;
+
   // The accelerations at the physical state x and M0 a into m0_v_, for a projection that
   // finishes N (every mode integrated: N = Phi^T M0 a + lambda z, project_then). False when the
   // forces are not finite or a body turned too far.
@@ -268,6 +272,13 @@ class ModalExponential : public Integrator {
   // 1e-4, 1e-5; tests/core/analysis/transient_auto_test.cpp). (Those were measured in the step's
   // weights; the iteration now stops in the motion's, correct().)
   static constexpr double kQuasiStaticTolerance = 1e-5;
+  // A step's change of the quasi-static part counts as its motion (QuasiStaticModes::accepted)
+  // where it is more than this many times the largest last correction of the iteration since the
+  // step before (its noise). The review's 100-segment cantilever under an 8 kN step
+  // (docs/transient_measurements.md "Damping that couples the modes goes on with dirk") had its
+  // largest |dy/dt|^2_M0 at a step of 1.2e-11 s, 6.7e9, where steps of 3e-6 s gave 1e-4 against
+  // the band's 0.01 to 200, and its run warned of an error of 3e7 of the motion.
+  static constexpr double kQuasiStaticNoiseMargin = 10.0;
   // The corrections of one evaluation of the band's forcing at most.
   static constexpr int kQuasiStaticIterations = 8;
   // A floating part is followed in a turning frame when it turns more than this over the run
@@ -339,7 +350,11 @@ class ModalExponential : public Integrator {
   ModalCoordinates coordinates_;   // the bodies' offsets from the linearization and back
   Block z_, x_;                    // the accepted state, modal and physical (x_ = Phi z_)
   Block accepted_x_;               // work space of nonlinear_at_accepted
-  Block xi_, x_next_;              // work space: a stage's physical state, a trial step's
+  // The largest last correction of the quasi-static iteration since the last accepted step, and
+  // the weights of the latest correction (translations, rotations): correct().
+  double qs_noise_ = 0.0;
+  double qs_weights_[2] = {1.0, 1.0};
+  Block xi_, x_next_;  // work space: a stage's physical state, a trial step's
   // A trial step's new state and its two error estimates side by side, modal and physical.
   Eigen::Matrix<double, Eigen::Dynamic, 6> trial_, trial_x_;
   // Work space: the modal states of the last two stages, a trial step's new state, its distances.

@@ -139,6 +139,8 @@ double ModalExponential::correct(const Eigen::VectorXd& psi_a, Block& x) {
   }
   const double w[2] = {options_.rtol * largest[0] + options_.atol,
                        options_.rtol * largest[1] + options_.atol};
+  qs_weights_[0] = w[0];
+  qs_weights_[1] = w[1];
   double sum = 0.0;
   for (Eigen::Index r = 0; r < n_; ++r) {
     const double e = dy(r) / w[(r % kD) / 3];
@@ -220,6 +222,7 @@ bool ModalExponential::nonlinear(double t, const Block& z, Block& x, Block& out,
     }
     if (size < kQuasiStaticTolerance || iteration >= kQuasiStaticIterations ||
         (iteration > 0 && size > 0.5 * last_size && size < 1.0)) {
+      qs_noise_ = std::max(qs_noise_, size);
       out.col(1) = psi_a_;
       break;
     }
@@ -228,6 +231,17 @@ bool ModalExponential::nonlinear(double t, const Block& z, Block& x, Block& out,
   out.col(1).array() += blocks_.lambda * z.col(0).array();
   if (blocks_.damped()) out.col(1).array() += blocks_.damping * z.col(1).array();
   return true;
+}
+
+bool ModalExponential::quasi_step_resolved() const {
+  const Eigen::VectorXd& y = quasi_.y();
+  const Eigen::VectorXd& start = quasi_.step_start();
+  double sum = 0.0;
+  for (Eigen::Index r = 0; r < n_; ++r) {
+    const double e = (y(r) - start(r)) / qs_weights_[(r % kD) / 3];
+    sum += e * e;
+  }
+  return std::sqrt(sum / static_cast<double>(n_)) > kQuasiStaticNoiseMargin * qs_noise_;
 }
 
 bool ModalExponential::nonlinear_at_accepted(int* flag) {
@@ -439,7 +453,9 @@ int ModalExponential::step_towards(double target) {
         x_.swap(x_next_);
         if (reduced_) {
           x_.col(0) += quasi_.y();
-          quasi_.accepted(h, StepFunctions::c[StepFunctions::kStages - 1], z_.col(1));
+          quasi_.accepted(h, StepFunctions::c[StepFunctions::kStages - 1], z_.col(1),
+                          quasi_step_resolved());
+          qs_noise_ = 0.0;
         }
         have_n0_ = false;
         starting_ = false;

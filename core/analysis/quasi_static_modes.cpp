@@ -67,7 +67,8 @@ bool QuasiStaticModes::update_tangent(const Eigen::SparseMatrix<double>& k) {
   return true;
 }
 
-void QuasiStaticModes::accepted(double h, double c, const Eigen::Ref<const Eigen::VectorXd>& nu) {
+void QuasiStaticModes::accepted(double h, double c, const Eigen::Ref<const Eigen::VectorXd>& nu,
+                                bool resolved) {
   // y_ is the last stage's, at c h into the step.
   work_n_ = (y_ - y_start_) / (c * h);
   y_begin_ = y_start_;
@@ -75,7 +76,7 @@ void QuasiStaticModes::accepted(double h, double c, const Eigen::Ref<const Eigen
   last_step_ = h;
   last_stage_ = c;
   rate_known_ = false;
-  kinetic_ = std::max(kinetic_, work_n_.dot(*m0_ * work_n_));
+  if (resolved) kinetic_ = std::max(kinetic_, work_n_.dot(*m0_ * work_n_));
   band_kinetic_ = std::max(band_kinetic_, nu.squaredNorm());
 }
 

@@ -54,14 +54,20 @@ class QuasiStaticModes {
 
   // The quasi-static part of the latest evaluation.
   Eigen::VectorXd& y() { return y_; }
+  const Eigen::VectorXd& y() const { return y_; }
 
   // A step's bookkeeping: y at the accepted state before its trials, and restored before each.
   void begin_step() { y_start_ = y_; }
   void restore() { y_ = y_start_; }
 
+  // y at the accepted state the step began from (begin_step).
+  const Eigen::VectorXd& step_start() const { return y_start_; }
+
   // After a step of size h is accepted, y being its last stage's (c h into it): the largest
-  // kinetic energies of y and of the band's velocities nu so far, and what rate() needs.
-  void accepted(double h, double c, const Eigen::Ref<const Eigen::VectorXd>& nu);
+  // kinetic energies of y and of the band's velocities nu so far, and what rate() needs. y's
+  // kinetic energy counts only where `resolved`: its change over the step stands above the
+  // iteration's noise (on a step of 1e-11 s that noise over the step is no velocity).
+  void accepted(double h, double c, const Eigen::Ref<const Eigen::VectorXd>& nu, bool resolved);
   // After a restart: no step since.
   void restart() {
     last_step_ = 0.0;

@@ -4,8 +4,8 @@
 //   linearized about the equilibrium under the loads at t = 0 (or the initial state), unless
 //   damping that couples its modes damps beyond kAutoMaxDampingRatio of the fastest mode's
 //   critical damping (each mode's own damping is exact in the modal method, the coupling
-//   explicit): then dirk (the default table). From kAutoChosenBandDofs on, the modal method's band is
-//   chosen for rtol (core/analysis/modal_band.hpp); when no band of the modes it may ask for
+//   explicit): then dirk (the default table). From kAutoChosenBandDofs on, the modal method's band
+//   is chosen for rtol (core/analysis/modal_band.hpp); when no band of the modes it may ask for
 //   meets rtol, every mode up to kModalIntegratorMaxDofs, else bdf.
 // - When a body turns more than kAutoRelinearizeRotation (less after cheap relinearizations,
 //   below) from the orientation it is linearized about, the modal method is linearized again about

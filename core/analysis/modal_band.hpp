@@ -32,7 +32,7 @@
 // (the horizon) moves less than those responses: there the size of a jump's or an initial
 // velocity's motion is its modes' linear response at 32 times up to the horizon (a 201-body
 // cantilever run for 10 ms, a twelfth of its period, chose bands that left 11 rtol of its own
-// motion; tests/core/analysis/transient_auto_test.cpp); a smooth load's is not reduced. The
+// motion; tests/core/analysis/transient_auto_band_test.cpp); a smooth load's is not reduced. The
 // nonlinear forcing is not in it: the modal method is for motions near its linearization (what
 // the quasi-static modes then miss, their inertia, is checked during the run:
 // core/analysis/quasi_static_modes.hpp). The band

@@ -155,7 +155,7 @@ class ModalExponential : public Integrator {
   // N m torque at 2 Hz for 1 s, came out 611 times rtol x + atol off its closed form with the
   // step's weights (3e-5 m across the swing: y stopped within 3e-10 m of a joint of 6e12 N/m),
   // and 0.04 times with the bob at the origin and the joint above it (tests/core/analysis/
-  // transient_auto_test.cpp, TransientBand). What it costs: docs/transient_measurements.md "A
+  // transient_auto_band_test.cpp, TransientBand). What it costs: docs/transient_measurements.md "A
   // band's quasi-static part, wherever the scene sits". Weights of each offset, rtol |x_i| + atol,
   // are tighter still where an offset is small (along a chain's stiff axis) and took the
   // 1,000-segment cantilever 115 s (these 107 s, the step's weights 73 s) for the same error; these
@@ -269,8 +269,8 @@ class ModalExponential : public Integrator {
   // under 1 N over 60 ms took 4,106 steps and 20,966 evaluations at 1e-3, 1,916 and 13,718 at
   // 1e-5, 1,348 and 18,180 at 1e-7 (1,349 and 27,525 at 1e-9); the 201-segment one over 10 ms
   // left 3.0 and 2.9 rtol at 1e-3 against an independent run, 0.54 and 0.71 rtol at 1e-5 (rtol
-  // 1e-4, 1e-5; tests/core/analysis/transient_auto_test.cpp). (Those were measured in the step's
-  // weights; the iteration now stops in the motion's, correct().)
+  // 1e-4, 1e-5; tests/core/analysis/transient_auto_band_test.cpp). (Those were measured in the
+  // step's weights; the iteration now stops in the motion's, correct().)
   static constexpr double kQuasiStaticTolerance = 1e-5;
   // A step's change of the quasi-static part counts as its motion (QuasiStaticModes::accepted)
   // where it is more than this many times the largest last correction of the iteration since the

@@ -1,7 +1,7 @@
 // Whether a transient's result can be trusted: the checks that make a run say so when it may not
-// be (optimizer/run/transient_analysis.cpp runs them after each transient): the energy drift of a scene
-// that keeps its energy, and the verification rerun (when a run is verified and what its rerun
-// found). Each warning is "" where there is nothing to say.
+// be (optimizer/run/transient_analysis.cpp runs them after each transient): the energy drift of a
+// scene that keeps its energy, and the verification rerun (when a run is verified and what its
+// rerun found). Each warning is "" where there is nothing to say.
 #pragma once
 
 #include <limits>

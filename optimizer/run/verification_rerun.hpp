@@ -1,6 +1,6 @@
 // A transient's verification rerun (its trajectory kept to compare with the run's;
-// optimizer/run/transient_analysis.cpp weighs it, transient_checks.hpp says when one is due), run after the
-// run or on its own thread beside it.
+// optimizer/run/transient_analysis.cpp weighs it, transient_checks.hpp says when one is due), run
+// after the run or on its own thread beside it.
 #pragma once
 
 #include <atomic>

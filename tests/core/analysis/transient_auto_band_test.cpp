@@ -14,11 +14,9 @@
 #include "core/analysis/modal_integrator.hpp"
 #include "core/scene/scene_loader.hpp"
 #include "tests/support/heavy_tip_cantilever.hpp"
-#include "tests/support/point_mass_tip.hpp"
 #include "tests/support/reference_cantilever.hpp"
 #include "tests/support/stiff_joint_bob.hpp"
 #include "tests/support/transient_run.hpp"
-#include "tests/support/tumbling_pair.hpp"
 
 namespace beamrail {
 namespace {

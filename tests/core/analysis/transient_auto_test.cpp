@@ -3,20 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
-#include <utility>
-#include <vector>
 
 #include "core/analysis/auto_integrator.hpp"
 #include "core/analysis/modal_integrator.hpp"
 #include "core/scene/scene_loader.hpp"
-#include "tests/support/heavy_tip_cantilever.hpp"
 #include "tests/support/point_mass_tip.hpp"
 #include "tests/support/reference_cantilever.hpp"
-#include "tests/support/stiff_joint_bob.hpp"
 #include "tests/support/transient_run.hpp"
 #include "tests/support/tumbling_pair.hpp"
 

@@ -212,6 +212,34 @@ bool ModalCoordinates::accelerations(const ModeBlock& x, const double* ydot,
   return true;
 }
 
+void ModalCoordinates::increment_maps(const ModeBlock& x, Eigen::SparseMatrix<double>* map,
+                                      Eigen::SparseMatrix<double>* inverse) const {
+  std::vector<Eigen::Triplet<double>> forward, backward;
+  forward.reserve(18 * c0_.size());
+  backward.reserve(18 * c0_.size());
+  const auto add = [](std::vector<Eigen::Triplet<double>>& out, Eigen::Index first,
+                      const Mat3& block) {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) out.emplace_back(first + i, first + j, block(i, j));
+  };
+  for (size_t b = 0; b < c0_.size(); ++b) {
+    const Eigen::Index first = kD * static_cast<Eigen::Index>(b);
+    const Vec3 theta = x.block<3, 1>(first + 3, 0);
+    Mat3 jacobian;
+    for (int j = 0; j < 3; ++j) jacobian.col(j) = angular_velocity(theta, Vec3::Unit(j));
+    const Mat3 frame = frame_of_[b] >= 0 ? frames_[frame_of_[b]].rotation : Mat3::Identity();
+    add(forward, first, frame);
+    add(forward, first + 3, frame * jacobian);
+    add(backward, first, frame.transpose());
+    add(backward, first + 3, jacobian.inverse() * frame.transpose());
+  }
+  const Eigen::Index n = kD * static_cast<Eigen::Index>(c0_.size());
+  map->resize(n, n);
+  map->setFromTriplets(forward.begin(), forward.end());
+  inverse->resize(n, n);
+  inverse->setFromTriplets(backward.begin(), backward.end());
+}
+
 double ModalCoordinates::largest_rotation(const ModeBlock& x) const {
   double largest = 0.0;
   for (size_t b = 0; b < c0_.size(); ++b)

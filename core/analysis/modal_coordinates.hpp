@@ -20,6 +20,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <cmath>
 #include <vector>
 
@@ -73,6 +74,14 @@ class ModalCoordinates {
   // The accelerations (dv/dt, d^2 theta/dt^2) into `out` at x from the derivatives ydot of the
   // 13 states that states() last wrote for x; false when ydot is not finite.
   bool accelerations(const ModeBlock& x, const double* ydot, Eigen::VectorXd& out) const;
+
+  // The map from increments of the offsets at x to increments of the generalized coordinates
+  // (core/model/generalized.hpp: global dc and rotation increments) and its inverse, block
+  // diagonal: per body R and R J(theta) (R the frame's rotation at the time of the last
+  // states(), I in fixed axes; J the left Jacobian, dA = [J dtheta]x A). A tangent stiffness K
+  // of the generalized coordinates is K T in the offsets'.
+  void increment_maps(const ModeBlock& x, Eigen::SparseMatrix<double>* map,
+                      Eigen::SparseMatrix<double>* inverse) const;
 
   // The largest rotation of a body from the reference at x [rad].
   double largest_rotation(const ModeBlock& x) const;

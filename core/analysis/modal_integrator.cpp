@@ -149,14 +149,32 @@ double ModalExponential::correct(const Eigen::VectorXd& psi_a, Block& x) {
   return std::sqrt(sum / static_cast<double>(n_));
 }
 
-bool ModalExponential::update_tangent() {
+bool ModalExponential::update_tangent(double t, const Block& x) {
   const Model& model = context_->model;
   Data& data = context_->data;
   set_state(model, data, y13_.data());
-  compute_wrenches(model, data, context_->force_time(t_));
-  compute_tangent(model, data, context_->force_time(t_), false);
+  compute_wrenches(model, data, context_->force_time(t));
+  compute_tangent(model, data, context_->force_time(t), false);
   ++stats_.jacobian_evaluations;
-  return quasi_.update_tangent(-stiffness_matrix(model, data));
+  // -d(M0 a)/dx = M0 T^-1 M(x)^-1 K T with the increment map T of the offsets at x (the terms of
+  // the velocities left out): the tangent K alone took the rotation vectors' increments for
+  // rotations, which is 1/2 theta off, and at a bent cantilever's tip (0.057 rad) that is 4.8e4
+  // N/rad of the tip's bending stiffness in its twist (whose own stiffness is 4.5e3): the
+  // iteration diverged (tests/core/analysis/transient_auto_band_test.cpp).
+  Eigen::SparseMatrix<double> map, inverse;
+  coordinates_.increment_maps(x, &map, &inverse);
+  const Eigen::SparseMatrix<double> mass = mass_matrix(model, data);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(3 * static_cast<size_t>(n_));
+  for (Eigen::Index first = 0; first < n_; first += 3) {
+    const Eigen::Matrix3d block = Eigen::Matrix3d(mass.block(first, first, 3, 3)).inverse();
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) entries.emplace_back(first + i, first + j, block(i, j));
+  }
+  Eigen::SparseMatrix<double> mass_inverse(n_, n_);
+  mass_inverse.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SparseMatrix<double> left = m0_ * inverse * mass_inverse;
+  return quasi_.update_tangent(left * (-stiffness_matrix(model, data)) * map);
 }
 
 void ModalExponential::from_states(const double* y) {
@@ -195,6 +213,7 @@ bool ModalExponential::nonlinear(double t, const Block& z, Block& x, Block& out,
   out.col(0).setZero();
   double last_size = 0.0;
   bool updated_here = false;
+  y_entry_ = quasi_.y();
   for (int iteration = 0;; ++iteration) {
     if (!evaluate(t, x, flag)) return false;
     psi_a_.resize(m_);
@@ -214,11 +233,27 @@ bool ModalExponential::nonlinear(double t, const Block& z, Block& x, Block& out,
       return false;
     }
     if (iteration > 0 && size > (updated_here ? 1.0 : 0.3) * last_size && size >= 1.0) {
-      if (updated_here || !update_tangent()) {
+      // The tangent where this evaluation began, and the iteration again from there: the
+      // corrections so far were made with the poor matrix, and the state they reached can be
+      // far off (stiff members stretched by them, whose tangent is then not positive definite).
+      if (updated_here) {
+        *flag = kNonFinite;
+        return false;
+      }
+      x.col(0) -= quasi_.y() - y_entry_;
+      quasi_.y() = y_entry_;
+      if (!states_of(t, x, y13_.data())) {
+        *flag = kTooFar;
+        return false;
+      }
+      if (!update_tangent(t, x)) {
         *flag = kNonFinite;
         return false;
       }
       updated_here = true;
+      last_size = 0.0;
+      iteration = -1;
+      continue;
     }
     if (size < kQuasiStaticTolerance || iteration >= kQuasiStaticIterations ||
         (iteration > 0 && size > 0.5 * last_size && size < 1.0)) {
@@ -255,6 +290,58 @@ bool ModalExponential::nonlinear_at_accepted(int* flag) {
   }
   if (!ok) x_.swap(accepted_x_);
   return ok;
+}
+
+bool ModalExponential::measure_pull(int* flag) {
+  // The band's static response to its forcing at the accepted state (n0_ = psi_a + lambda z):
+  // dz = psi_a / lambda for the elastic modes (a rigid or mechanism mode has none).
+  const Eigen::ArrayXd& lambda = blocks_.lambda;
+  const double largest = lambda.size() > 0 ? lambda.maxCoeff() : 0.0;
+  Block dz = Block::Zero(m_, 2);
+  for (Eigen::Index i = 0; i < m_; ++i) {
+    if (!(lambda[i] > 1e-8 * largest)) continue;
+    const double damping = blocks_.damped() ? blocks_.damping[i] * z_(i, 1) : 0.0;
+    dz(i, 0) = (n0_(i, 1) - lambda[i] * z_(i, 0) - damping) / lambda[i];
+  }
+  Block target;
+  multiply(phi_, dz, target);
+  // A target beyond half the rotation limit is approached by the share s that reaches it: the
+  // pull is of second order (the band's modes move no stiffness outside it at first order), so
+  // its ratio grows as s^2 and is divided by that.
+  const double turn = coordinates_.largest_rotation(target);
+  const double s = turn > 0.5 * max_rotation_ ? 0.5 * max_rotation_ / turn : 1.0;
+  dz *= s;
+  const double band = dz.col(0).squaredNorm();
+  if (!(band > 0.0)) return true;
+  Block target_z = z_ + dz;
+  multiply(phi_, target_z, target);
+  const Eigen::VectorXd start = quasi_.y();
+  target.col(0) += start;
+  Block out;
+  int target_flag = kOk;
+  bool ok = false;
+  const bool updated = quasi_.updated();
+  const double noise = qs_noise_;
+  const std::string out_of_range = context_->out_of_range;
+  const Eigen::VectorXd psi_a = psi_a_;  // the band's forcing at the accepted state (start_ringing)
+  try {
+    ok = nonlinear(t_, target_z, target, out, &target_flag);
+  } catch (const std::exception&) {
+    ok = false;
+  }
+  const Eigen::VectorXd dy = quasi_.y() - start;
+  // The accepted state's evaluation again (data.pose, the accelerations: edge_step reads them)
+  // and its Newton matrix.
+  quasi_.y() = start;
+  qs_noise_ = noise;
+  context_->out_of_range = out_of_range;
+  psi_a_ = psi_a;
+  if (!updated) quasi_.reset_tangent();
+  if (!evaluate(t_, x_, flag)) return false;
+  if (!ok) return true;  // the iteration does not reach the band's target: the run's check stays
+  pull_ = dy.dot(m0_ * dy) / band / (s * s);
+  quasi_.set_pull(pull_);
+  return true;
 }
 
 bool ModalExponential::evaluate(double t, const Block& x, int* flag) {
@@ -388,6 +475,12 @@ int ModalExponential::step_towards(double target) {
       if (reduced_ ? !nonlinear_at_accepted(&flag) : !evaluate(t_, x_, &flag))
         return fail_flag(flag);
       have_n0_ = reduced_;
+      if (reduced_ && stats_.steps == 0 && pull_ < 0.0) {
+        pull_ = 0.0;
+        if (!measure_pull(&flag)) return fail_flag(flag);
+        // Already past what the run may drop: it stops before its first step (auto widens).
+        if (inertia_limit_ > 0.0 && quasi_static_inertia().drift > inertia_limit_) return kInertia;
+      }
     }
     if (reduced_) quasi_.begin_step();  // the quasi-static part at the accepted state
     if (h_ <= 0.0) h_ = options_.initial_step > 0.0 ? options_.initial_step : (target - t_);
@@ -578,6 +671,13 @@ bool set_modal_inertia_limit(Integrator& integrator, double drift) {
   auto* modal = dynamic_cast<ModalExponential*>(&integrator);
   if (!modal || !modal->band_limited()) return false;
   modal->set_inertia_limit(drift);
+  return true;
+}
+
+bool set_modal_settling_start(Integrator& integrator, double t) {
+  auto* modal = dynamic_cast<ModalExponential*>(&integrator);
+  if (!modal || !modal->band_limited()) return false;
+  modal->set_settling_start(t);
   return true;
 }
 

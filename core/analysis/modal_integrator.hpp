@@ -138,6 +138,10 @@ std::string quasi_static_inertia_warning(const QuasiStaticInertia& inertia);
 // QuasiStaticInertia drift first passes `drift` (0: never, the default), so that its caller can
 // go on with more modes; false when `integrator` is not a band-limited modal integrator.
 bool set_modal_inertia_limit(Integrator& integrator, double drift);
+// That check waits until the band's slowest elastic mode has turned far enough since t (before
+// the integrator's own start: a band relinearized, whose phases are each too short to settle);
+// false when `integrator` is not a band-limited modal one.
+bool set_modal_settling_start(Integrator& integrator, double t);
 
 // The step size a modal integrator would try next [s]; 0 when `integrator` is not one.
 double modal_step_size(const Integrator& integrator);

@@ -39,8 +39,8 @@ bool QuasiStaticModes::init(const Eigen::SparseMatrix<double>& k0,
 
 const Eigen::VectorXd& QuasiStaticModes::correct(const Eigen::VectorXd& m0_a,
                                                  const Eigen::VectorXd& psi_a) {
-  dy_ = k0_.solve(m0_a);
   if (updated_) {
+    dy_ = tangent_.solve(m0_a);
     // With the tangent K of a later state: dy = K^-1 (M0 a - Psi l), Psi^T dy = 0.
     m0_dy_.noalias() = *m0_ * dy_;
     psi_dy_.resize(phi_->cols());
@@ -48,6 +48,7 @@ const Eigen::VectorXd& QuasiStaticModes::correct(const Eigen::VectorXd& m0_a,
     work_m_ = schur_.solve(psi_dy_);
     subtract_product(kinv_psi_, work_m_, work_n_, dy_);
   } else {
+    dy_ = k0_.solve(m0_a);
     work_m_ = psi_a.array() / (lambda_ + shift_);
     subtract_product(*phi_, work_m_, work_n_, dy_);
   }
@@ -56,12 +57,13 @@ const Eigen::VectorXd& QuasiStaticModes::correct(const Eigen::VectorXd& m0_a,
 }
 
 bool QuasiStaticModes::update_tangent(const Eigen::SparseMatrix<double>& k) {
-  const Eigen::SparseMatrix<double> symmetric =
-      0.5 * Eigen::SparseMatrix<double>(k + Eigen::SparseMatrix<double>(k.transpose()));
-  k0_.factorize(Eigen::SparseMatrix<double>(symmetric + shift_ * *m0_));
-  if (k0_.info() != Eigen::Success || !(k0_.vectorD().array() > 0.0).all()) return false;
+  Eigen::SparseMatrix<double> shifted = k + shift_ * *m0_;
+  shifted.makeCompressed();
+  tangent_.compute(shifted);
+  if (tangent_.info() != Eigen::Success) return false;
   const Eigen::MatrixXd psi = *m0_ * *phi_;
-  kinv_psi_ = k0_.solve(psi);
+  kinv_psi_ = tangent_.solve(psi);
+  if (!kinv_psi_.allFinite()) return false;
   schur_.compute(psi.transpose() * kinv_psi_);
   updated_ = true;
   return true;
@@ -92,8 +94,9 @@ QuasiStaticInertia QuasiStaticModes::inertia(double band_hz, double t, double el
   QuasiStaticInertia q;
   q.band_hz = band_hz;
   q.t = t;
-  if (!(band_kinetic_ > 0.0)) return q;
-  q.ratio = kinetic_ / band_kinetic_;
+  q.ratio = pull_;
+  if (band_kinetic_ > 0.0) q.ratio = std::max(q.ratio, kinetic_ / band_kinetic_);
+  if (!(q.ratio > 0.0)) return q;
   const double w = std::max(std::sqrt(std::max(0.0, lowest_elastic_)), forcing_rate_);
   q.drift = 0.5 * q.ratio * std::max(1.0, w * elapsed);
   return q;

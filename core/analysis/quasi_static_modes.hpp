@@ -29,6 +29,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
 #include <cmath>
 
 #include "core/analysis/modal_integrator.hpp"
@@ -48,9 +49,14 @@ class QuasiStaticModes {
   // added to y; returns dy (valid until the next call).
   const Eigen::VectorXd& correct(const Eigen::VectorXd& m0_a, const Eigen::VectorXd& psi_a);
 
-  // The Newton matrix from the tangent stiffness k of a later state (its symmetric part); false
-  // when k + mu M0 is not positive definite.
+  // The Newton matrix from the tangent k = -d(M0 a)/dx of a later state (not symmetric where
+  // the offsets' rotations are not the tangent's increments: ModalCoordinates::increment_maps);
+  // false when k + mu M0 is singular.
   bool update_tangent(const Eigen::SparseMatrix<double>& k);
+
+  // Whether the Newton matrix is a later tangent's (update_tangent), and back to K0's.
+  bool updated() const { return updated_; }
+  void reset_tangent() { updated_ = false; }
 
   // The quasi-static part of the latest evaluation.
   Eigen::VectorXd& y() { return y_; }
@@ -82,8 +88,13 @@ class QuasiStaticModes {
 
   // The highest harmonic load's angular frequency [rad/s] (0: none), for inertia().
   void set_forcing_rate(double w) { forcing_rate_ = w; }
-  // What leaving out y's kinetic energy does after `elapsed` seconds of the run (above).
+  // What leaving out y's kinetic energy does after `elapsed` seconds of the run (above). Its
+  // ratio is at least the pull measured at the start (set_pull).
   QuasiStaticInertia inertia(double band_hz, double t, double elapsed) const;
+  // The ratio of y's change to the band's, |dy|^2_M0 / |Phi dz|^2_M0, when the band moves from
+  // the run's start to its static response there (ModalExponential::measure_pull): the kinetic
+  // energy y would carry against the band's, as they move together.
+  void set_pull(double ratio) { pull_ = ratio; }
   // Whether the band's slowest elastic mode (or the motion at a harmonic load's frequency, when
   // faster) has turned `angle` rad in `elapsed` seconds.
   bool settled(double elapsed, double angle) const {
@@ -96,8 +107,9 @@ class QuasiStaticModes {
   const Eigen::MatrixXd* phi_ = nullptr;
   Eigen::ArrayXd lambda_;
   double shift_ = 0.0;                                     // mu [1/s^2]
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> k0_;  // of K0 + mu M0, or a later K
-  bool updated_ = false;      // k0_ holds a later tangent (then kinv_psi_, schur_)
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> k0_;  // of K0 + mu M0
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> tangent_;   // of a later K + mu M0
+  bool updated_ = false;      // tangent_ holds a later tangent (then kinv_psi_, schur_)
   Eigen::MatrixXd kinv_psi_;  // K^-1 Psi
   Eigen::PartialPivLU<Eigen::MatrixXd> schur_;  // of Psi^T K^-1 Psi
   Eigen::VectorXd y_, dy_, y_start_;
@@ -110,6 +122,7 @@ class QuasiStaticModes {
   bool rate_known_ = false;
   double kinetic_ = 0.0;          // the largest |dy/dt|^2_M0 so far
   double band_kinetic_ = 0.0;     // and |nu|^2
+  double pull_ = 0.0;             // set_pull
   double lowest_elastic_ = -1.0;  // the lowest elastic w^2 in the band (-1: none)
   double forcing_rate_ = 0.0;     // the highest harmonic load's w [rad/s]
 };

@@ -534,27 +534,25 @@ TEST(TransientAuto, ADampedGroundedMechanismRunsDirk) {
   EXPECT_LT(ef, 10 * rtol);
 }
 
-// A modal phase that fails after reaching its output time (a band's quasi-static part at the state
-// reached) hands over there, and the next method starts with the next output interval. Issue 17's
-// stiff-hinge pendulum with the user's band of 100 Hz, which keeps the axle's stiff modes
-// quasi-static while the bob swings through them: the band's iteration fails at the output time
-// 0.1 s. The run stopped there with ARKODE's "tstop = 0.1 is behind current t = 0.1" and a
-// message blaming its input; it now goes on with dirk and keeps the band's warning (its dropped
-// inertia: 0.26 of the kinetic energy), which says the run is not to be trusted.
-TEST(TransientAuto, APhaseThatFailsAtItsOutputTimeHandsOverThere) {
+// A band's quasi-static part at the state a modal phase reached at its output time: the stiff-hinge
+// pendulum of issue 17 with the user's band of 100 Hz, which keeps the axle's stiff modes
+// quasi-static while the bob swings through them. The band's iteration used to fail at the output
+// time 0.1 s (its Newton matrix took the rotation vectors' increments for rotations): the run
+// stopped there with ARKODE's "tstop = 0.1 is behind current t = 0.1" and a message blaming its
+// input, and later went on with dirk from there. Now the band runs through, relinearized as the
+// bob turns, and keeps its warning (its dropped inertia: 0.26 of the kinetic energy), which says
+// the run is not to be trusted. (No scene of the suite now fails at an output time; that hand-over
+// stays in core/analysis/auto_integrator.cpp.)
+TEST(TransientAuto, AStiffHingeInAGivenBandRunsThroughAndSaysWhatItDrops) {
   const Model model = scene_from_json(testing::kStiffHingePendulum);
   const TransientRun run = run_with(model, "auto", 0.2, 0.01, 1e-6, 100.0);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   EXPECT_EQ(run.result.t_reached, 0.2);
-  const MethodPhase& last = run.result.phases.back();
-  std::printf("stiff-hinge pendulum, band 100 Hz: %s from t = %.17g s (%s)\n", last.method.c_str(),
-              last.t, last.reason.c_str());
-  EXPECT_EQ(last.method.rfind("dirk", 0), 0u) << last.method;
-  EXPECT_NE(last.reason.find("the modal method failed"), std::string::npos) << last.reason;
-  EXPECT_DOUBLE_EQ(last.t, 0.1);
+  for (const MethodPhase& p : run.result.phases) EXPECT_EQ(p.method, "modal") << p.reason;
   bool warned = false;
   for (const std::string& w : run.result.warnings)
-    warned = warned || w.find("band-limited run (100 Hz)") != std::string::npos;
+    warned = warned || (w.find("band-limited run (100 Hz)") != std::string::npos &&
+                        w.find("above rtol") != std::string::npos);
   EXPECT_TRUE(warned);
 }
 

@@ -4,6 +4,7 @@
 // auto 12 to 537 rtol off on them, status ok) against an explicit Verner 8(7) run at rtol 1e-11.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -108,6 +109,64 @@ TEST(TurningFrame, CoordinatesGoBothWaysAndARigidTurnWithTheFrameIsNoOffset) {
   }
   frame.offsets(t, turned.data(), back);
   EXPECT_LT(back.cwiseAbs().maxCoeff(), 1e-14) << back;
+}
+
+// The increment map of the offsets (ModalCoordinates::increment_maps: what the quasi-static
+// iteration's Newton matrix takes a tangent stiffness through) against central differences of
+// states(): the centres' and the orientations' changes (the rotation vector of A+ A-^T, global
+// axes) per offset, with rotation vectors of 0.5 to 0.9 rad, in fixed axes and in a turning frame.
+TEST(TurningFrame, TheIncrementMapIsTheDerivativeOfTheStates) {
+  const Model model = scene_from_json(pair("[0.1, 0.1, 8]", "[0.05, 0.1, 8]", "1.2"));
+  std::vector<double> y0(model.n_states);
+  initial_state(model, y0.data());
+  for (const bool turning : {false, true}) {
+    ModalCoordinates coordinates;
+    coordinates.set_reference(model, y0.data());
+    if (turning) {
+      const std::vector<int> part = floating_parts(model).front();
+      coordinates.set_turning_frame(0.5, rigid_motion(model, y0.data(), part), part);
+    }
+    ModeBlock x(12, 2);
+    for (int i = 0; i < 12; ++i) {
+      x(i, 0) = (i % 6 < 3 ? 1e-2 : 0.5) * std::sin(1.0 + i);
+      x(i, 1) = 0.1 * std::cos(2.0 + i);
+    }
+    x.block<3, 1>(3, 0) = Vec3(0.4, -0.5, 0.3);
+    x.block<3, 1>(9, 0) = Vec3(-0.2, 0.6, 0.6);
+    const double t = 0.73, h = 1e-6;
+    std::vector<double> plus(model.n_states), minus(model.n_states), at(model.n_states);
+    ASSERT_TRUE(coordinates.states(t, x, at.data()));
+    Eigen::SparseMatrix<double> map, inverse;
+    coordinates.increment_maps(x, &map, &inverse);
+    const Eigen::MatrixXd dense = Eigen::MatrixXd(map);
+    double largest = 0.0;
+    for (int k = 0; k < 12; ++k) {
+      ModeBlock xp = x, xm = x;
+      xp(k, 0) += h;
+      xm(k, 0) -= h;
+      ASSERT_TRUE(coordinates.states(t, xp, plus.data()));
+      ASSERT_TRUE(coordinates.states(t, xm, minus.data()));
+      Eigen::VectorXd column(12);
+      for (int b = 0; b < 2; ++b) {
+        const double* p = plus.data() + kStatesPerBody * b;
+        const double* m = minus.data() + kStatesPerBody * b;
+        for (int j = 0; j < 3; ++j) column(6 * b + j) = (p[j] - m[j]) / (2 * h);
+        const Mat3 ap = rotation_matrix<double>(Vec4(p[3], p[4], p[5], p[6]));
+        const Mat3 am = rotation_matrix<double>(Vec4(m[3], m[4], m[5], m[6]));
+        column.segment<3>(6 * b + 3) = rotation_vector(ap * am.transpose()) / (2 * h);
+      }
+      largest = std::max(largest, (column - dense.col(k)).cwiseAbs().maxCoeff());
+    }
+    std::printf("%s: largest difference from central differences %.2e\n",
+                turning ? "turning frame" : "fixed axes", largest);
+    EXPECT_LT(largest, 1e-8);
+    // Not the identity: the rotation vectors' increments are not rotations (J(theta)).
+    EXPECT_GT((dense - Eigen::MatrixXd::Identity(12, 12)).cwiseAbs().maxCoeff(), 0.1);
+    EXPECT_LT((Eigen::MatrixXd(inverse) * dense - Eigen::MatrixXd::Identity(12, 12))
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-14);
+  }
 }
 
 // Each set of free bodies joined to each other and to nothing fixed is a part; bodies joined

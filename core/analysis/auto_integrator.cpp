@@ -169,9 +169,10 @@ class AutoIntegrator : public Integrator {
             return kAutoFailed;
           continue;
         }
-        // A first modal phase that failed before its first step left nothing of its model in
-        // the run: what its set-up warned of (its band, its linearization) does not apply.
-        if (count_ == 1 && current_->stats().steps == 0)
+        // Modal phases that failed before their first step (the first, and those relinearized
+        // at once as a body turned) left nothing of their model in the run: what the first's
+        // set-up warned of (its band, its linearization) does not apply.
+        if (before_.steps == 0 && current_->stats().steps == 0)
           warnings.erase(warnings.begin() + static_cast<long>(first_modal_warnings_),
                          warnings.begin() + static_cast<long>(first_modal_warnings_end_));
         before_ = sum(before_, current_->stats());

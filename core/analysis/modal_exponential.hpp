@@ -294,6 +294,8 @@ class ModalExponential : public Integrator {
   static constexpr double kQuasiStaticNoiseMargin = 10.0;
   // The corrections of one evaluation of the band's forcing at most.
   static constexpr int kQuasiStaticIterations = 8;
+  // The Newton matrix's updates within one evaluation at most (nonlinear()).
+  static constexpr int kQuasiStaticUpdates = 3;
   // A floating part is followed in a turning frame when it turns more than this over the run
   // [rad].
   static constexpr double kTurningFrameMinTurn = 1e-3;

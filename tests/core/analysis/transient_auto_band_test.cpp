@@ -131,11 +131,13 @@ TEST(TransientAuto, ABandWhoseQuasiStaticModesArePulledAlongWidensBeforeItsFirst
 }
 
 // Where the modal method fails, auto goes on from the last accepted state (issue 17: a default
-// that never collapses): in a band given, with dirk. The heavy tip above in a band of 100 Hz (the
-// one auto chooses at the start): the modal method alone in a band chosen for rtol fails (at
-// 0.14 s, "the forces became non-finite"); auto's phases in the band given go on with dirk (from
-// 0.196 s). That band is the model asked for: it is kept, its run is off beyond rtol (the inertia
-// its quasi-static modes leave out), and it says so.
+// that never collapses): in a band given, with dirk. The heavy tip above in a band of 150 Hz:
+// the modal method alone in a band chosen for rtol fails (at 0.14 s, "the forces became
+// non-finite"); auto's phases in the band given go on with dirk (from 0.196 s; the band of 100 Hz
+// auto chooses at the start failed there too until the quasi-static iteration could take its
+// tangent again where it stalled, and now runs through, warned). That band is the model asked
+// for: it is kept, its run is off beyond rtol (the inertia its quasi-static modes leave out), and
+// it says so.
 TEST(TransientAuto, AFailedModalPhaseGoesOnWithTheImplicitMethod) {
   const Model model = scene_from_json(testing::heavy_tip_cantilever(R"("value": [0, -300, 0])"));
   const double rtol = 1e-4;
@@ -149,7 +151,7 @@ TEST(TransientAuto, AFailedModalPhaseGoesOnWithTheImplicitMethod) {
 
   o.integrator.method = IntegratorMethod::kAuto;
   o.integrator.choose_band = false;
-  o.integrator.max_frequency_hz = 100.0;
+  o.integrator.max_frequency_hz = 150.0;
   const TransientRun run = simulate(model, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   const std::vector<MethodPhase>& phases = run.result.phases;
@@ -190,11 +192,11 @@ Model bent_cantilever(double force) {
 // (nonlinear_at_accepted, core/analysis/modal_exponential.hpp). The cantilever above under 20 N in
 // a band of 30 Hz given (an adversarial review, 2026-12-03): auto's dirk went on at t = 0 from
 // that diverged state, the tip moving up against the load with 4.0 J the scene never had, and
-// ran out of its 60 s at 0.124 s of 0.5 s, 1.5e4 rtol off at rtol 1e-6. Under 20 N that band now
-// runs (below); under 60 N its iteration still fails at the start. Here (0.02 s, rtol 1e-4) the
-// first output agrees with dirk's alone.
+// ran out of its 60 s at 0.124 s of 0.5 s, 1.5e4 rtol off at rtol 1e-6. Under 20 to 100 N that
+// band now runs (below); under 150 N its iteration still fails at the start. Here (0.02 s, rtol
+// 1e-4) the first output agrees with dirk's alone.
 TEST(TransientAuto, AModalPhaseFailedAtItsStartHandsOverTheStateItAccepted) {
-  const Model model = bent_cantilever(60.0);
+  const Model model = bent_cantilever(150.0);
   const double t_end = 0.02, output_step = 2e-3, rtol = 1e-4;
   TransientOptions o = options(t_end, output_step, 1e-9, 1e-12);
   o.integrator.method = IntegratorMethod::kDirk;
@@ -206,11 +208,15 @@ TEST(TransientAuto, AModalPhaseFailedAtItsStartHandsOverTheStateItAccepted) {
   const TransientRun run = simulate(model, o);
   ASSERT_TRUE(run.result.ok) << run.result.message;
   const std::vector<MethodPhase>& phases = run.result.phases;
-  ASSERT_EQ(phases.size(), 2u);
-  EXPECT_EQ(phases[1].method, std::string("dirk ") + kAutoImplicitTable);
-  EXPECT_EQ(phases[1].t, 0.0);
-  EXPECT_NE(phases[1].reason.find("the modal method failed ("), std::string::npos)
-      << phases[1].reason;
+  ASSERT_GE(phases.size(), 2u);  // the modal phases (relinearized at t = 0 as the tip turns)
+  for (size_t k = 0; k + 1 < phases.size(); ++k) {
+    EXPECT_EQ(phases[k].method, "modal") << phases[k].reason;
+    EXPECT_EQ(phases[k].t, 0.0);
+  }
+  EXPECT_EQ(phases.back().method, std::string("dirk ") + kAutoImplicitTable);
+  EXPECT_EQ(phases.back().t, 0.0);
+  EXPECT_NE(phases.back().reason.find("the modal method failed ("), std::string::npos)
+      << phases.back().reason;
   // The tip at the first output: pulled down by the load, as dirk's alone.
   size_t tip = 0;
   while (tip < model.bodies.size() && model.bodies[tip].name != "tip") ++tip;

@@ -1,6 +1,7 @@
 // The modal exponential integrator's class (core/analysis/modal_integrator.hpp is its interface):
 // set up in core/analysis/modal_basis.cpp (the linearization, the modes, a band, their damping),
-// stepped in core/analysis/modal_integrator.cpp. Internal to those two files.
+// stepped in core/analysis/modal_integrator.cpp, its band's quasi-static part iterated in
+// core/analysis/modal_quasi_static.cpp. Internal to those three files.
 #pragma once
 
 #include <algorithm>

@@ -169,12 +169,7 @@ class AutoIntegrator : public Integrator {
             return kAutoFailed;
           continue;
         }
-        // Modal phases that failed before their first step (the first, and those relinearized
-        // at once as a body turned) left nothing of their model in the run: what the first's
-        // set-up warned of (its band, its linearization) does not apply.
-        if (before_.steps == 0 && current_->stats().steps == 0)
-          warnings.erase(warnings.begin() + static_cast<long>(first_modal_warnings_),
-                         warnings.begin() + static_cast<long>(first_modal_warnings_end_));
+        withdraw_stepless_modal_warnings(before_.steps == 0 && current_->stats().steps == 0);
         before_ = sum(before_, current_->stats());
         std::string error;
         if (!start_method(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
@@ -212,6 +207,8 @@ class AutoIntegrator : public Integrator {
         continue;
       }
       short_runs_ = steps < kAutoMinStepsPerLinearization ? short_runs_ + 1 : 0;
+      short_run_steps_ = short_runs_ == 1 ? steps : std::max(short_run_steps_, steps);
+      const bool no_step_yet = before_.steps == 0 && steps == 0;
       before_ = sum(before_, current_->stats());
       const double turned = rotation_limit_;
       if (short_runs_ >= 3 && rotation_limit_ < kAutoRelinearizeRotation) {
@@ -221,11 +218,18 @@ class AutoIntegrator : public Integrator {
         rotation_limit_ = kAutoRelinearizeRotation;
         short_runs_ = 0;
       } else if (short_runs_ >= 3) {
+        withdraw_stepless_modal_warnings(no_step_yet);
+        // No step in any of them: a body beyond the limit at once (a band's quasi-static part
+        // at the state itself), not a fast turn.
+        const std::string why = short_run_steps_ == 0
+                                    ? "relinearizing without a step, three times running (body " +
+                                          who + " " + number(rotation_limit_) +
+                                          " rad from each linearization at once)"
+                                    : "relinearizing every " + std::to_string(short_run_steps_) +
+                                          " steps or sooner (body " + who + " turns " +
+                                          number(rotation_limit_) + " rad that fast)";
         std::string error;
-        if (!start_method(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y,
-                          "relinearizing every " + std::to_string(steps) + " steps (body " + who +
-                              " turns " + number(rotation_limit_) + " rad that fast)",
-                          &error))
+        if (!start_method(IntegratorMethod::kDirk, kAutoImplicitTable, *t, y, why, &error))
           return fail(error);
         continue;
       }
@@ -449,6 +453,16 @@ class AutoIntegrator : public Integrator {
     if (QuasiStaticInertia q; modal_quasi_static_inertia(*current_, &q)) add(inertia_, q);
   }
 
+  // Modal phases that ran no step before a fallback (the first, and those relinearized at once
+  // as a body turned) left nothing of their model in the run: what the first's set-up warned of
+  // (its band, its linearization) does not apply, and is withdrawn when `stepless`.
+  void withdraw_stepless_modal_warnings(bool stepless) {
+    if (!stepless) return;
+    warnings.erase(warnings.begin() + static_cast<long>(first_modal_warnings_),
+                   warnings.begin() + static_cast<long>(first_modal_warnings_end_));
+    first_modal_warnings_end_ = first_modal_warnings_;
+  }
+
   int fail(const std::string& why) {
     failure_ = why;
     return kAutoFailed;
@@ -501,6 +515,7 @@ class AutoIntegrator : public Integrator {
   bool widened_ = false;      // a chosen band was widened (widen_band): to widened_hz_
   double widened_hz_ = 0.0;   // [Hz]; 0: every mode
   int short_runs_ = 0;        // consecutive linearizations that lasted few steps
+  long short_run_steps_ = 0;  // the most steps of one of them
   double rotation_limit_ = kAutoRelinearizeRotation;     // of the current linearization [rad]
   double smallest_limit_ = kAutoMinRelinearizeRotation;  // the limit halves down to this
   SolverStats before_;                                   // of the phases before the current one

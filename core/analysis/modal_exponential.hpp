@@ -297,6 +297,9 @@ class ModalExponential : public Integrator {
   static constexpr int kQuasiStaticIterations = 8;
   // The Newton matrix's updates within one evaluation at most (nonlinear()).
   static constexpr int kQuasiStaticUpdates = 3;
+  // After an update, a correction more than this part of the one before takes the tangent
+  // again where it is (a chord iteration gone stale; nonlinear()).
+  static constexpr double kQuasiStaticSlowContraction = 0.5;
   // A floating part is followed in a turning frame when it turns more than this over the run
   // [rad].
   static constexpr double kTurningFrameMinTurn = 1e-3;

@@ -70,8 +70,8 @@ bool ModalExponential::nonlinear(double t, const Block& z, Block& x, Block& out,
     // tolerance (the accelerations of the last evaluation are kept).
     const double size = correct(psi_a_, x);
     // A correction that grows, or shrinks slowly, beyond the tolerance: the Newton matrix
-    // is updated to the tangent where the evaluation began (below; again where it stalls after
-    // falling, at most kQuasiStaticUpdates times); if it then grows, the state is
+    // is updated to the tangent where the evaluation began (below; again where it shrinks
+    // slowly or grows, at most kQuasiStaticUpdates times); if it then grows, the state is
     // too far out for the iteration (a trial step too long), which fails like non-finite
     // forces: the step is retried shorter. One that stops shrinking within the tolerance is
     // at its rounding floor. (Failing on a slow shrink after the update too failed the
@@ -81,17 +81,22 @@ bool ModalExponential::nonlinear(double t, const Block& z, Block& x, Block& out,
       *flag = kNonFinite;
       return false;
     }
-    if (iteration > 0 && size > (updated_here ? 1.0 : 0.3) * last_size && size >= 1.0) {
+    const bool slow = size > (updated_here ? kQuasiStaticSlowContraction : 0.3) * last_size;
+    // Shrinking slowly with no update left: it goes on (at most kQuasiStaticIterations).
+    const bool no_update_left = updated_here && updates >= kQuasiStaticUpdates;
+    if (iteration > 0 && slow && size >= 1.0 && !(no_update_left && size <= last_size)) {
       // The tangent where this evaluation began, and the iteration again from there: the
       // corrections so far were made with the poor matrix, and the state they reached can be
       // far off (stiff members stretched by them, whose tangent is then not positive definite).
-      // Once updated, an iteration that stalls or grows takes the tangent again where it is, up
-      // to kQuasiStaticUpdates in all: a bent cantilever under 60 N stalled at 1.5 weights after
-      // 56 (the corrections had turned its stiff segments); the straight one under a 150 N step
-      // went 2,613 -> 573 -> 604 weights with the tangent where it began (its linearization's),
-      // exact there, and converged from the tangent at 604 (124, 11, 1.1, 0.11, ...): the
-      // segments' axial stiffness against the corrections' turn, second order in them.
-      if (updated_here && updates >= kQuasiStaticUpdates) {
+      // Once updated, an iteration that shrinks by less than kQuasiStaticSlowContraction takes
+      // the tangent again where it is, up to kQuasiStaticUpdates in all: a bent cantilever
+      // under 60 N stalled at 1.5 weights after 56 (the corrections had turned its stiff
+      // segments); the straight one under a 150 N step went 2,613 -> 573 -> 604 weights with
+      // the tangent where it began (its linearization's), exact there, and converged from the
+      // tangent at 604 (124, 11, 1.1, 0.11, ...): the segments' axial stiffness against the
+      // corrections' turn, second order in them. Under 200 N, 1,299 -> 1,143 (a chord
+      // iteration gone stale), then 253, 61, 15, 3.9, 1.0, 0.27 from the tangent at 1,143.
+      if (no_update_left) {
         *flag = kNonFinite;
         return false;
       }
